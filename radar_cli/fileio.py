@@ -1,0 +1,104 @@
+"""Atomic file writes (temp file + rename) and safe image reading: the only way radar writes results."""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, Iterator
+
+import numpy as np
+from PIL import Image
+
+from radar_cli.errors import InputError
+
+MAX_IMAGE_PIXELS = 100_000_000  # decompression-bomb limit for untrusted images
+Image.MAX_IMAGE_PIXELS = MAX_IMAGE_PIXELS
+
+
+@contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """Yield a temporary path next to `path`; on success rename it over `path`, on failure remove it."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp" + path.suffix)
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        yield tmp_path
+        os.replace(tmp_path, path)
+    except BaseException:
+        tmp_path.unlink(missing_ok=True)
+        raise
+
+
+def write_bytes(path: str | Path, data: bytes) -> None:
+    """Write bytes atomically."""
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data)
+
+
+def write_text(path: str | Path, text: str) -> None:
+    """Write text (UTF-8) atomically."""
+    write_bytes(path, text.encode("utf-8"))
+
+
+def write_json(path: str | Path, obj: Any) -> None:
+    """Write an object as indented JSON atomically."""
+    write_text(path, json.dumps(obj, indent=2, sort_keys=True) + "\n")
+
+
+def write_npy(path: str | Path, array: np.ndarray) -> None:
+    """Write a numpy array atomically."""
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as f:
+            np.save(f, array)
+
+
+def to_uint8(image: np.ndarray) -> np.ndarray:
+    """Convert a float image in [0, 1] (H x W or H x W x C) to uint8, clipping."""
+    return (np.clip(image, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+
+
+def write_image(path: str | Path, image: np.ndarray) -> None:
+    """Write an image atomically; float arrays are taken as [0, 1], uint8 as is. H x W or H x W x {3,4}."""
+    if image.dtype != np.uint8:
+        image = to_uint8(image)
+    with atomic_path(path) as tmp:
+        Image.fromarray(image).save(tmp, format=_format_for(Path(path)))
+
+
+def _format_for(path: Path) -> str:
+    ext = path.suffix.lower()
+    return {".png": "PNG", ".jpg": "JPEG", ".jpeg": "JPEG", ".gif": "GIF", ".webp": "WEBP"}.get(ext, "PNG")
+
+
+def read_image(path: str | Path, mode: str = "RGB") -> np.ndarray:
+    """Read an image file as uint8 (H x W x 3 for RGB, H x W for L), honouring EXIF orientation.
+
+    Grey, palette, RGBA, CMYK and 16-bit images are converted. Raises InputError naming the file on any
+    decoding problem, including decompression bombs.
+    """
+    from PIL import ImageOps
+
+    path = Path(path)
+    try:
+        with Image.open(path) as im:
+            im = ImageOps.exif_transpose(im)
+            if im.mode in ("I;16", "I;16B", "I;16L", "I"):
+                arr = np.asarray(im, dtype=np.float64)
+                scale = 65535.0 if arr.max() > 255 else 255.0
+                im = Image.fromarray((arr / scale * 255.0).clip(0, 255).astype(np.uint8))
+            if mode == "RGB" and im.mode in ("RGBA", "LA", "PA") or (im.mode == "P" and "transparency" in im.info):
+                im = im.convert("RGBA")
+                background = Image.new("RGBA", im.size, (255, 255, 255, 255))
+                im = Image.alpha_composite(background, im)
+            return np.asarray(im.convert(mode)).copy()
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except Image.DecompressionBombError as e:
+        raise InputError(f"{path}: image too large ({e})") from None
+    except (OSError, ValueError, SyntaxError) as e:
+        raise InputError(f"{path}: not a readable image ({e})") from None
