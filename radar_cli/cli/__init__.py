@@ -12,9 +12,7 @@ from radar_cli import __version__
 from radar_cli.errors import RadarError
 
 # (module, command attribute): one line per working subcommand.
-COMMANDS = [
-    ("radar_cli.cli.demo", "demo"),
-    ("radar_cli.cli.bench", "bench"),
+COMMANDS: list[tuple[str, str]] = [
 ]
 
 
