@@ -1,0 +1,103 @@
+"""Texture rendering R_I(V, v, T) and unwrapping eta(V, v, I) (paper Eq. 3-4), in image and unwrapped space.
+
+Texture maps are B x C x Ht x Wt. A frontal map covers phi in [-60, 60] deg; a full map covers 360 deg with
+3 * Wt columns, and its middle third is the frontal map.
+"""
+
+from __future__ import annotations
+
+import torch
+import torch.nn.functional as F
+
+from radar_cli.checks import check_shape
+from radar_cli.config import CameraConfig
+from radar_cli.render.raycast import Hits
+from radar_cli.sor.camera import project
+from radar_cli.sor.profile import check_sor
+from radar_cli.sor.surface import FRONT_SPAN, surface_grid
+
+
+def front_third(texture: torch.Tensor) -> torch.Tensor:
+    """The frontal third (B x C x Ht x Wt) of a full 360 deg map (B x C x Ht x 3Wt)."""
+    w = texture.shape[-1] // 3
+    return texture[..., w : 2 * w]
+
+
+def full_from_front(front: torch.Tensor) -> torch.Tensor:
+    """A 360 deg map from a frontal third by mirroring it onto the sides and back, as the paper does for
+    visualisation: [mirror | front | mirror], B x C x Ht x 3Wt, seamless at both joins."""
+    mirrored = torch.flip(front, dims=[-1])
+    return torch.cat([mirrored, front, mirrored], dim=-1)
+
+
+def render_texture(
+    hits: Hits,
+    texture: torch.Tensor,
+    front_only: bool = False,
+    inside_dim: float = 0.5,
+    background: float = 0.0,
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """Render a texture map onto the image through the ray-casting result.
+
+    Args:
+        hits: Hits of B images of size H x W.
+        texture: B x C x Ht x Wt' map; a frontal third if front_only, otherwise a full 360 deg map.
+        front_only: render only the frontal third of the outer surface (for L_im); other pixels get background.
+        inside_dim: brightness factor for the inside of the vase (full renders).
+        background: value of pixels without surface.
+
+    Returns:
+        image: B x C x H x W, anti-aliased by the soft silhouette at the object's outline.
+        mask: B x 1 x H x W float, the pixels that carry texture (the rendered frontal silhouette if front_only).
+    """
+    dims = check_shape(hits.sil, "B H W", "hits.sil")
+    check_shape(texture, "B C T U", "texture", {"B": dims["B"]})
+    u, v = hits.uv[..., 0], hits.uv[..., 1]
+    if front_only:
+        u = u * (torch.pi / FRONT_SPAN)
+        mask = hits.mask & ~hits.inner & (u.abs() <= 1.0)
+        color = F.grid_sample(texture, torch.stack([u, v], -1), mode="bilinear", padding_mode="border",
+                              align_corners=False)
+        m = mask[:, None].to(texture.dtype)
+        return color * m + background * (1 - m), m
+    # wrap around the seam: pad one column from the other side, then map u onto the padded width
+    w = texture.shape[-1]
+    padded = torch.cat([texture[..., -1:], texture, texture[..., :1]], dim=-1)
+    u_pad = u * (w / (w + 2))
+    color = F.grid_sample(padded, torch.stack([u_pad, v], -1), mode="bilinear", padding_mode="border",
+                          align_corners=False)
+    dim = torch.where(hits.inner, inside_dim, 1.0).to(texture.dtype)[:, None]
+    coverage = torch.where(hits.mask, torch.ones_like(hits.sil), hits.sil)[:, None]
+    # the outline is anti-aliased by the soft silhouette; inside the vase the hit decides
+    alpha = torch.where(hits.mask[:, None], coverage, hits.sil[:, None])
+    image = color * dim * alpha + background * (1 - alpha)
+    return image, hits.mask[:, None].to(texture.dtype)
+
+
+def unwrap(
+    radius: torch.Tensor,
+    height: torch.Tensor,
+    pose: torch.Tensor,
+    image: torch.Tensor,
+    tex_size: tuple[int, int],
+    camera: CameraConfig = CameraConfig(),
+) -> torch.Tensor:
+    """Unwrap the frontal third of the surface from an image into texture space (Eq. 4).
+
+    Every texel's surface point is known in closed form; it is projected into the image and sampled bilinearly.
+    Differentiable in the image, the shape and the pose.
+
+    Args:
+        radius: B x L, height: B, pose: B x 4 (see cast_rays).
+        image: B x C x H x W.
+        tex_size: (Ht, Wt) of the frontal texture.
+
+    Returns:
+        B x C x Ht x Wt frontal texture.
+    """
+    check_sor(radius, height, pose)
+    check_shape(image, "B C H W", "image", {"B": radius.shape[0]})
+    rows, cols = tex_size
+    grid = surface_grid(radius, height, pose, rows, cols, camera)
+    xy = project(grid.points, camera)  # B x rows x cols x 2
+    return F.grid_sample(image, xy, mode="bilinear", padding_mode="border", align_corners=False)
