@@ -1,0 +1,1 @@
+"""The RADAR networks (shape, lighting, albedo, discriminator), their outputs and their losses."""

@@ -1,0 +1,150 @@
+"""Whole-object rendering: shade an albedo map under an environment map (Eq. 5-8) and draw it, from the
+original view (frontal third, for training) or from any new view and lighting (full 360 deg, for export).
+
+Everything here composes the lower-level ops (ray casting, texture render/unwrap, shading); synthesis, the
+model, de-rendering and relighting all call these functions so that they render the same way.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import torch
+import torch.nn.functional as F
+
+from radar_cli.checks import check_shape
+from radar_cli.config import CameraConfig, RenderConfig
+from radar_cli.render.lighting import check_material, compose, shading_factors, upsample
+from radar_cli.render.raycast import Hits, cast_rays
+from radar_cli.render.texture import render_texture
+from radar_cli.sor.surface import FRONT_SPAN, FULL_SPAN, surface_grid
+
+
+@dataclass(frozen=True)
+class Shading:
+    """Lighting factors and the shaded texture in unwrapped space (Eq. 5-7).
+
+    Attributes:
+        diffuse: B x 1 x Ht x Wt diffuse factor I_d (linear).
+        specular: B x 1 x Ht x Wt specular factor I_s (linear, before rho).
+        texture: B x 3 x Ht x Wt tone-mapped shaded texture T = tau(A * I_d + rho * I_s).
+        normals: B x 3 x Ht x Wt camera-space unit normals at the texels (upsampled from the shading grid).
+    """
+
+    diffuse: torch.Tensor
+    specular: torch.Tensor
+    texture: torch.Tensor
+    normals: torch.Tensor
+
+
+def shade(
+    radius: torch.Tensor,
+    height: torch.Tensor,
+    pose: torch.Tensor,
+    albedo: torch.Tensor,
+    env: torch.Tensor,
+    alpha: torch.Tensor,
+    rho: torch.Tensor,
+    render: RenderConfig = RenderConfig(),
+    camera: CameraConfig = CameraConfig(),
+    span: float = FRONT_SPAN,
+) -> Shading:
+    """Shade an unwrapped albedo map of the SoR under an environment map.
+
+    Lighting is evaluated on a coarse (render.shading_height x shading_width * span / FRONT_SPAN) grid and
+    upsampled bilinearly to the albedo's size, as the original implementation does.
+
+    Args:
+        radius: B x L radius column; height: B; pose: B x 4 (see cast_rays).
+        albedo: B x 3 x Ht x Wt linear albedo in [0, 1]; the frontal third if span = FRONT_SPAN, the whole
+            360 deg map (column 0 at the back, -180 deg) if span = FULL_SPAN.
+        env: B x He x We environment map (>= 0), camera frame.
+        alpha: B shininess; rho: B specular albedo.
+        span: half-width in radians of the angular range the albedo covers.
+
+    Returns:
+        Shading at the albedo's resolution.
+    """
+    dims = check_shape(albedo, "B 3 Ht Wt", "albedo", {"B": radius.shape[0]})
+    check_shape(env, "B He We", "env", dims)
+    check_material(alpha, rho, env)
+    rows = render.shading_height
+    cols = max(1, round(render.shading_width * span / FRONT_SPAN))
+    grid = surface_grid(radius, height, pose, rows, cols, camera, span)
+    diffuse, specular = shading_factors(grid.normals, grid.view, env, alpha)  # B x rows x cols each
+    size = (dims["Ht"], dims["Wt"])
+    diffuse = upsample(diffuse[:, None], size)
+    specular = upsample(specular[:, None], size)
+    normals = upsample(grid.normals.permute(0, 3, 1, 2), size)
+    normals = normals / normals.norm(dim=1, keepdim=True).clamp_min(1e-6)
+    texture = compose(albedo, diffuse, specular, rho, render.gamma)
+    return Shading(diffuse, specular, texture, normals)
+
+
+def render_front(hits: Hits, texture: torch.Tensor, background: float = 0.0) -> tuple[torch.Tensor, torch.Tensor]:
+    """Draw a frontal-third texture map into the image: R_I(V_f, v, T) of Eq. 9.
+
+    Args:
+        hits: ray-casting result for B images.
+        texture: B x C x Ht x Wt frontal map.
+
+    Returns:
+        (image B x C x H x W, frontal mask B x 1 x H x W float: the rendered silhouette of the frontal part).
+    """
+    return render_texture(hits, texture, front_only=True, background=background)
+
+
+def rotate_full_map(texture: torch.Tensor, yaw_deg: float) -> torch.Tensor:
+    """Spin a 360 deg map about the axis: the content at angle phi moves to phi + yaw (B x C x Ht x 3Wt)."""
+    width = texture.shape[-1]
+    shift = yaw_deg / 360.0 * width
+    whole = math.floor(shift)
+    frac = shift - whole
+    rolled = torch.roll(texture, shifts=whole, dims=-1)
+    if frac == 0:
+        return rolled
+    return (1 - frac) * rolled + frac * torch.roll(rolled, shifts=1, dims=-1)
+
+
+def render_view(
+    radius: torch.Tensor,
+    height: torch.Tensor,
+    pose: torch.Tensor,
+    albedo_full: torch.Tensor,
+    env: torch.Tensor,
+    alpha: torch.Tensor,
+    rho: torch.Tensor,
+    size: int,
+    yaw_deg: float = 0.0,
+    render: RenderConfig = RenderConfig(),
+    camera: CameraConfig = CameraConfig(),
+    background: float = 1.0,
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """Render the whole object, shaded, from the given pose after spinning it by `yaw_deg` about its axis.
+
+    New views: change pose (pitch, roll) and yaw. New lighting: pass another env (camera frame).
+    The inside of an open vase is drawn dimmed by render.inside_dim.
+
+    Args:
+        radius: B x L; height: B; pose: B x 4.
+        albedo_full: B x 3 x Ht x 3Wt linear 360 deg albedo (middle third = the frontal view at yaw 0).
+        env: B x He x We; alpha, rho: B.
+        size: output image side in pixels.
+
+    Returns:
+        (image B x 3 x H x W tone-mapped over `background`, mask B x 1 x H x W float coverage).
+    """
+    albedo = rotate_full_map(albedo_full, yaw_deg)
+    shading = shade(radius, height, pose, albedo, env, alpha, rho, render, camera, span=FULL_SPAN)
+    hits = cast_rays(radius, height, pose, size, camera, render.sil_sigma_px)
+    image, mask = render_texture(hits, shading.texture, front_only=False, inside_dim=render.inside_dim,
+                                 background=background)
+    del mask
+    coverage = torch.where(hits.mask, torch.ones_like(hits.sil), hits.sil)[:, None]
+    return image, coverage
+
+
+def sample_env(env: torch.Tensor, size: tuple[int, int]) -> torch.Tensor:
+    """Resample an environment map (B x He x We) to another equirectangular size, preserving mean radiance."""
+    return F.interpolate(env[:, None], size=size, mode="bilinear", align_corners=False)[:, 0]
