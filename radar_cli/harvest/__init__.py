@@ -1,0 +1,1 @@
+"""Harvesting a museum collection: Met API client, SQLite catalog, validated image downloads."""

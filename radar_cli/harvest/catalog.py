@@ -1,0 +1,212 @@
+"""The harvest catalog: one SQLite file in DATA with one row per object (state, reason, metadata, image facts).
+
+States follow the pipeline: `searched` (id known) -> `record` (object record stored, image wanted) -> `image`
+(image validated and stored). `skipped` rows carry a reason (not_found, bad_id, not_public_domain, no_image,
+image_too_large); `failed` rows carry the error and are retried on the next run. Every update is its own
+transaction, so a killed run leaves a consistent catalog. Later stages read it through `iter_images`.
+"""
+
+from __future__ import annotations
+
+import sqlite3
+from collections import Counter
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any, Iterable, Iterator
+
+from radar_cli.errors import InputError
+
+CATALOG_NAME = "catalog.sqlite"
+STATES = ("searched", "record", "image", "skipped", "failed")
+LICENCE_PD = "CC0-1.0"
+LICENCE_OTHER = "not public domain"
+
+# Catalog column -> object record field, for the metadata later stages need.
+RECORD_FIELDS = {
+    "title": "title",
+    "object_name": "objectName",
+    "classification": "classification",
+    "department": "department",
+    "culture": "culture",
+    "object_date": "objectDate",
+    "object_url": "objectURL",
+    "credit_line": "creditLine",
+    "metadata_date": "metadataDate",
+}
+
+SCHEMA = """
+CREATE TABLE IF NOT EXISTS objects (
+    object_id INTEGER PRIMARY KEY,
+    rank INTEGER NOT NULL,
+    state TEXT NOT NULL,
+    reason TEXT NOT NULL DEFAULT '',
+    title TEXT, object_name TEXT, classification TEXT, department TEXT, culture TEXT, object_date TEXT,
+    object_url TEXT, licence TEXT, credit_line TEXT, metadata_date TEXT,
+    image_url TEXT, record_path TEXT, image_path TEXT, bytes INTEGER, sha256 TEXT, etag TEXT,
+    updated_at TEXT NOT NULL
+);
+CREATE INDEX IF NOT EXISTS objects_state ON objects (state, rank);
+CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+"""
+
+
+@dataclass(frozen=True)
+class ImageEntry:
+    """One harvested image with what is needed to attribute results derived from it."""
+
+    object_id: int
+    image_path: Path
+    title: str
+    credit_line: str
+    licence: str
+    object_url: str
+
+
+def _now() -> str:
+    return datetime.now(timezone.utc).isoformat(timespec="seconds")
+
+
+class Catalog:
+    """The SQLite catalog of one harvest folder (WAL mode, one transaction per update).
+
+    Args:
+        path: the catalog file (created with its schema when missing).
+    """
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            self.db = sqlite3.connect(self.path, isolation_level=None, timeout=30.0)
+            self.db.row_factory = sqlite3.Row
+            self.db.execute("PRAGMA journal_mode=WAL")
+            self.db.execute("PRAGMA synchronous=NORMAL")
+            self.db.executescript(SCHEMA)
+        except sqlite3.DatabaseError as e:
+            raise InputError(f"{self.path}: not a usable catalog ({e})") from None
+
+    def close(self) -> None:
+        """Close the database connection."""
+        self.db.close()
+
+    def __enter__(self) -> "Catalog":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # --- writing -------------------------------------------------------------------------------------------
+    def add_searched(self, object_ids: Iterable[int]) -> int:
+        """Add new ids in the given order as `searched`; known ids are left alone. Returns how many were new."""
+        (top,) = self.db.execute("SELECT COALESCE(MAX(rank), -1) FROM objects").fetchone()
+        new = 0
+        with self.db:
+            self.db.execute("BEGIN")
+            for object_id in object_ids:
+                cur = self.db.execute(
+                    "INSERT OR IGNORE INTO objects (object_id, rank, state, updated_at) VALUES (?, ?, 'searched', ?)",
+                    (int(object_id), top + 1 + new, _now()))
+                new += cur.rowcount
+        return new
+
+    def set_record(self, object_id: int, record: dict[str, Any], record_path: str, image_url: str,
+                   state: str, reason: str = "") -> None:
+        """Store the metadata of a fetched object record and move it to `state` (record or skipped)."""
+        values = {col: str(record.get(key) or "") for col, key in RECORD_FIELDS.items()}
+        values["licence"] = LICENCE_PD if record.get("isPublicDomain") is True else LICENCE_OTHER
+        cols = ", ".join(f"{c} = :{c}" for c in values)
+        self.db.execute(
+            f"UPDATE objects SET {cols}, record_path = :record_path, image_url = :image_url, state = :state, "
+            "reason = :reason, updated_at = :now WHERE object_id = :id",
+            {**values, "record_path": record_path, "image_url": image_url, "state": state, "reason": reason,
+             "now": _now(), "id": object_id})
+
+    def set_image(self, object_id: int, image_path: str, size: int, sha256: str, etag: str) -> None:
+        """Mark an object's image as validated and stored."""
+        self.db.execute(
+            "UPDATE objects SET state = 'image', reason = '', image_path = ?, bytes = ?, sha256 = ?, etag = ?, "
+            "updated_at = ? WHERE object_id = ?", (image_path, size, sha256, etag, _now(), object_id))
+
+    def set_state(self, object_id: int, state: str, reason: str = "") -> None:
+        """Move an object to `skipped` or `failed` (with its reason or error), or back to an earlier state."""
+        assert state in STATES, state
+        self.db.execute("UPDATE objects SET state = ?, reason = ?, updated_at = ? WHERE object_id = ?",
+                        (state, reason, _now(), object_id))
+
+    def mark_changed(self, object_ids: Iterable[int]) -> int:
+        """Send known objects whose record changed back to `searched` (image facts kept). Returns the count."""
+        n = 0
+        with self.db:
+            self.db.execute("BEGIN")
+            for object_id in object_ids:
+                n += self.db.execute(
+                    "UPDATE objects SET state = 'searched', reason = '', updated_at = ? "
+                    "WHERE object_id = ? AND state != 'searched'", (_now(), int(object_id))).rowcount
+        return n
+
+    def set_meta(self, key: str, value: str) -> None:
+        """Store a run-level setting or fact."""
+        self.db.execute("INSERT OR REPLACE INTO meta (key, value) VALUES (?, ?)", (key, value))
+
+    # --- reading -------------------------------------------------------------------------------------------
+    def get_meta(self, key: str, default: str | None = None) -> str | None:
+        """Read a run-level setting or fact."""
+        row = self.db.execute("SELECT value FROM meta WHERE key = ?", (key,)).fetchone()
+        return default if row is None else row[0]
+
+    def get(self, object_id: int) -> sqlite3.Row | None:
+        """One object's row, or None."""
+        return self.db.execute("SELECT * FROM objects WHERE object_id = ?", (object_id,)).fetchone()
+
+    def pending_records(self) -> list[int]:
+        """Ids whose record is still to fetch: `searched`, or `failed` before a record was stored."""
+        return [r[0] for r in self.db.execute(
+            "SELECT object_id FROM objects WHERE state = 'searched' "
+            "OR (state = 'failed' AND image_url IS NULL) ORDER BY rank")]
+
+    def pending_images(self) -> list[int]:
+        """Ids whose image is still to fetch: `record`, or `failed` after the record was stored."""
+        return [r[0] for r in self.db.execute(
+            "SELECT object_id FROM objects WHERE state = 'record' "
+            "OR (state = 'failed' AND image_url IS NOT NULL) ORDER BY rank")]
+
+    def counts(self) -> dict[str, int]:
+        """Number of objects per state (every state present, zeros included)."""
+        found = dict(self.db.execute("SELECT state, COUNT(*) FROM objects GROUP BY state").fetchall())
+        return {s: found.get(s, 0) for s in STATES}
+
+    def skip_reasons(self) -> Counter[str]:
+        """Number of skipped objects per reason."""
+        return Counter(dict(self.db.execute(
+            "SELECT reason, COUNT(*) FROM objects WHERE state = 'skipped' GROUP BY reason").fetchall()))
+
+    def rows(self) -> list[dict[str, Any]]:
+        """Every row as a dict, in search order."""
+        return [dict(r) for r in self.db.execute("SELECT * FROM objects ORDER BY rank")]
+
+
+def open_catalog(data_dir: str | Path) -> Catalog:
+    """Open (or create) the catalog of a harvest folder."""
+    return Catalog(Path(data_dir) / CATALOG_NAME)
+
+
+def iter_images(data_dir: str | Path) -> Iterator[ImageEntry]:
+    """Yield every harvested image of a folder, in search order, with its attribution.
+
+    Args:
+        data_dir: the folder `radar fetch --out` wrote.
+
+    Raises:
+        InputError: no catalog in the folder.
+    """
+    data_dir = Path(data_dir)
+    if not (data_dir / CATALOG_NAME).is_file():
+        raise InputError(f"{data_dir / CATALOG_NAME}: no harvest catalog (run `radar fetch --out {data_dir}`)")
+    with open_catalog(data_dir) as catalog:
+        rows = catalog.db.execute(
+            "SELECT object_id, image_path, title, credit_line, licence, object_url FROM objects "
+            "WHERE state = 'image' ORDER BY rank").fetchall()
+    for r in rows:
+        yield ImageEntry(r["object_id"], data_dir / r["image_path"], r["title"], r["credit_line"], r["licence"],
+                         r["object_url"])

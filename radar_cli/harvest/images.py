@@ -1,0 +1,81 @@
+"""Validate a downloaded image (decode it fully, refuse decompression bombs) and commit it by atomic rename."""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+from PIL import Image
+
+from radar_cli.fileio import write_bytes
+
+MAX_PIXELS = 64_000_000  # the Met's originals are at most ~4000 x 6000 px
+EXTENSIONS = {"JPEG": ".jpg", "PNG": ".png", "TIFF": ".tif", "WEBP": ".webp", "GIF": ".gif"}
+
+
+class ImageRejected(Exception):
+    """A downloaded body is not an image we keep.
+
+    `skip_reason` is set for permanent rejections (the object is skipped for that reason); None means the body
+    may have been damaged in transfer, so the object is marked failed and retried on the next run.
+    """
+
+    def __init__(self, message: str, skip_reason: str | None):
+        super().__init__(message)
+        self.skip_reason = skip_reason
+
+
+@dataclass(frozen=True)
+class StoredImage:
+    """An image committed to disk."""
+
+    path: Path
+    size: int
+    sha256: str
+
+
+def validate_image(body: bytes, max_pixels: int = MAX_PIXELS) -> str:
+    """Decode the whole image and return its file extension (".jpg", ...).
+
+    Args:
+        body: the downloaded bytes.
+        max_pixels: largest width x height accepted (decompression-bomb guard, checked before decoding).
+
+    Raises:
+        ImageRejected: too many pixels or an unsupported format (permanent), or not decodable (retryable).
+    """
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            with Image.open(io.BytesIO(body)) as im:
+                width, height = im.size
+                if width * height > max_pixels:
+                    raise ImageRejected(f"image too large ({width} x {height} px > {max_pixels} px)", "image_too_large")
+                fmt = im.format or ""
+                im.load()  # decodes every byte: truncated or corrupt data raises here
+    except ImageRejected:
+        raise
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning) as e:
+        raise ImageRejected(f"image too large ({e})", "image_too_large") from None
+    except (OSError, ValueError, SyntaxError, EOFError) as e:
+        raise ImageRejected(f"corrupt image ({e})", None) from None
+    if fmt not in EXTENSIONS:
+        raise ImageRejected(f"unsupported image format {fmt or 'unknown'}", "unsupported_format")
+    return EXTENSIONS[fmt]
+
+
+def store_image(body: bytes, folder: Path, object_id: int, max_pixels: int = MAX_PIXELS) -> StoredImage:
+    """Validate an image and write it as `folder/<object_id><ext>` by atomic rename.
+
+    The file name comes from the numeric object id only, never from the remote URL.
+
+    Raises:
+        ImageRejected: see `validate_image`.
+    """
+    ext = validate_image(body, max_pixels)
+    path = folder / f"{int(object_id)}{ext}"
+    write_bytes(path, body)
+    return StoredImage(path, len(body), hashlib.sha256(body).hexdigest())
