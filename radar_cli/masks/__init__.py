@@ -1,0 +1,1 @@
+"""Photographs -> square training crops with silhouettes: detect, refine (GrabCut), crop, score, write."""

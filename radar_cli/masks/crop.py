@@ -1,0 +1,96 @@
+"""Square crops around an object, sized so it fills the frame like the renderer's vases fill theirs.
+
+The network's camera sees a vase whose half-height is 0.5..0.95 of the half-view; a crop whose side is the
+object's extent divided by `fill` (default 0.85) puts a real photo's object in the middle of that range.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+DEFAULT_MARGIN = 0.075  # per side, as a fraction of the crop: the object spans 1 - 2 * margin = 0.85
+
+
+@dataclass(frozen=True)
+class CropBox:
+    """A square window of the original photo, in its pixels (may reach outside it; the outside is padded)."""
+
+    x0: int
+    y0: int
+    side: int
+
+    def to_list(self) -> list[int]:
+        return [self.x0, self.y0, self.side]
+
+
+def mask_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
+    """(x0, y0, x1, y1) half-open bounding box of a bool mask, or None if it is empty."""
+    ys, xs = np.nonzero(mask)
+    if len(xs) == 0:
+        return None
+    return int(xs.min()), int(ys.min()), int(xs.max()) + 1, int(ys.max()) + 1
+
+
+def square_box(box: tuple[float, float, float, float], margin: float = DEFAULT_MARGIN) -> CropBox:
+    """The square crop centred on `box` (x0, y0, x1, y1) whose side makes the box's longer extent span
+    1 - 2 * margin of it."""
+    x0, y0, x1, y1 = box
+    fill = 1.0 - 2.0 * margin
+    side = max(2, int(round(max(x1 - x0, y1 - y0) / fill)))
+    cx, cy = (x0 + x1) / 2.0, (y0 + y1) / 2.0
+    return CropBox(int(round(cx - side / 2.0)), int(round(cy - side / 2.0)), side)
+
+
+def cut(image: np.ndarray, crop: CropBox, size: int) -> np.ndarray:
+    """The crop of an H x W (x C) image, resized to size x size; outside the photo the edge is replicated.
+
+    Returns:
+        size x size (x C), same dtype.
+    """
+    h, w = image.shape[:2]
+    x0, y0, x1, y1 = crop.x0, crop.y0, crop.x0 + crop.side, crop.y0 + crop.side
+    pad = (max(0, -y0), max(0, y1 - h), max(0, -x0), max(0, x1 - w))
+    window = image[max(0, y0) : min(h, y1), max(0, x0) : min(w, x1)]
+    if any(pad):
+        window = cv2.copyMakeBorder(window, *pad, borderType=cv2.BORDER_REPLICATE)
+    interp = cv2.INTER_AREA if crop.side > size else cv2.INTER_LINEAR
+    return cv2.resize(window, (size, size), interpolation=interp)
+
+
+def crop_affine(crop: CropBox, size: int, scale: float = 1.0) -> np.ndarray:
+    """2 x 3 affine taking pixel centres of an image at `scale` x the original's resolution into the crop's
+    size x size pixel grid."""
+    k = size / crop.side
+    # original x = (x_s + 0.5) / scale - 0.5 ; crop u = (x - x0 + 0.5) * k - 0.5
+    a = k / scale
+    bx = (0.5 / scale - 0.5 - crop.x0 + 0.5) * k - 0.5
+    by = (0.5 / scale - 0.5 - crop.y0 + 0.5) * k - 0.5
+    return np.array([[a, 0.0, bx], [0.0, a, by]], np.float64)
+
+
+def warp_mask(mask: np.ndarray, affine: np.ndarray, size: int) -> np.ndarray:
+    """Warp a bool mask by a 2 x 3 affine into a size x size bool mask (bilinear on 0/1, cut at 0.5)."""
+    src = mask.astype(np.float32)
+    if affine[0, 0] < 0.5:  # shrinking: average first so thin parts are not lost to point sampling
+        factor = affine[0, 0]
+        h, w = mask.shape
+        nw, nh = max(1, round(w * factor)), max(1, round(h * factor))
+        src = cv2.resize(src, (nw, nh), interpolation=cv2.INTER_AREA)
+        pre = np.array([[w / nw, 0, 0.5 * w / nw - 0.5], [0, h / nh, 0.5 * h / nh - 0.5], [0, 0, 1]])
+        affine = (np.vstack([affine, [0, 0, 1]]) @ pre)[:2]
+    out = cv2.warpAffine(src, affine, (size, size), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
+    return out > 0.5
+
+
+def valid_region(crop: CropBox, image_shape: tuple[int, ...], size: int) -> tuple[int, int, int, int]:
+    """(u0, v0, u1, v1): the part of the size x size crop that shows real photo pixels (not padding)."""
+    h, w = image_shape[:2]
+    k = size / crop.side
+    u0 = int(np.ceil(max(0, -crop.x0) * k))
+    v0 = int(np.ceil(max(0, -crop.y0) * k))
+    u1 = int(np.floor(min(crop.side, w - crop.x0) * k))
+    v1 = int(np.floor(min(crop.side, h - crop.y0) * k))
+    return u0, v0, max(u0, u1), max(v0, v1)

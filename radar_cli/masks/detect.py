@@ -1,0 +1,249 @@
+"""Classical object detector for studio photographs: the background is modelled from the image border.
+
+Museum photographs are mostly taken against plain or gradient backdrops. A low-order (quadratic) colour model is
+fitted robustly to a band along the image border; a pixel's distance from that model, in units of the border's
+own noise, says how unlike the backdrop it is. Edges and spectral-residual saliency (opencv-contrib) add
+evidence where the object's colour is close to the backdrop. Connected components that are large enough become
+instances, one per object.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+WORK_SIDE = 320  # detection runs at this long edge; refinement happens later at crop resolution
+BORDER_FRAC = 0.04  # width of the border band the backdrop is fitted to, as a fraction of the long edge
+MIN_AREA_FRAC = 0.01  # components smaller than this fraction of the image are noise (labels, dust)
+MIN_REL_AREA = 0.2  # ... and components smaller than this fraction of the largest one are dropped too
+GROUP_GAP = 0.03  # components whose boxes come this close (fraction of the long edge) are one object
+LIGHT_RANGE = (0.2, 1.6)  # brightness ratios to the backdrop model that shading of the backdrop can explain
+
+
+@dataclass(frozen=True)
+class Detection:
+    """One object found in a photograph.
+
+    Attributes:
+        mask: h x w bool at detection scale (the photo resized so its long edge is `WORK_SIDE`).
+        box: (x0, y0, x1, y1) in the ORIGINAL photo's pixels, half-open.
+        score: mean foreground evidence inside the mask, in [0, 1] (higher = more clearly not backdrop).
+        scale: detection pixels per original pixel.
+    """
+
+    mask: np.ndarray
+    box: tuple[float, float, float, float]
+    score: float
+    scale: float
+
+
+def downscale(image: np.ndarray, long_side: int = WORK_SIDE) -> tuple[np.ndarray, float]:
+    """Resize an H x W x 3 uint8 image so its long edge is `long_side` (never enlarge much); return it and the
+    scale factor (work pixels per original pixel)."""
+    scale = long_side / max(image.shape[:2])
+    if abs(scale - 1.0) < 1e-3:
+        return image, 1.0
+    h, w = (max(1, round(s * scale)) for s in image.shape[:2])
+    interp = cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR
+    return cv2.resize(image, (w, h), interpolation=interp), scale
+
+
+def border_band(shape: tuple[int, int], frac: float = BORDER_FRAC) -> np.ndarray:
+    """H x W bool, True in a band along the image border `frac` of the long edge wide (at least 2 px)."""
+    h, w = shape
+    k = max(2, round(frac * max(h, w)))
+    band = np.zeros((h, w), bool)
+    band[:k], band[-k:], band[:, :k], band[:, -k:] = True, True, True, True
+    return band
+
+
+def _design(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """N x 6 quadratic design matrix of normalised coordinates in [-1, 1]."""
+    return np.stack([np.ones_like(xs), xs, ys, xs * ys, xs * xs, ys * ys], axis=1)
+
+
+def fit_backdrop(image: np.ndarray, band: np.ndarray, rounds: int = 3) -> tuple[np.ndarray, np.ndarray]:
+    """Model the backdrop colour everywhere from the border band.
+
+    A quadratic colour surface per channel is fitted to the band with iterated trimming (labels, objects that
+    touch the border are outliers); what the quadratic misses along the border (sweeps, vignetting) is carried
+    inward by harmonic interpolation of the inlier residuals.
+
+    Args:
+        image: H x W x C float32.
+        band: H x W bool, the pixels assumed to be mostly backdrop.
+
+    Returns:
+        model: H x W x C backdrop colour; noise: C robust std of the band's pixel-to-pixel variation (>= 1.5).
+    """
+    h, w, c = image.shape
+    gy, gx = np.mgrid[0:h, 0:w].astype(np.float32)
+    gx, gy = gx / max(w - 1, 1) * 2 - 1, gy / max(h - 1, 1) * 2 - 1
+    ys, xs = np.nonzero(band)
+    a_all = _design(gx[ys, xs], gy[ys, xs])  # N x 6
+    values = image[ys, xs]  # N x C
+    keep = np.ones(len(ys), bool)
+    for _ in range(rounds):
+        coef, *_ = np.linalg.lstsq(a_all[keep], values[keep], rcond=None)  # 6 x C
+        resid = np.linalg.norm(values - a_all @ coef, axis=1)
+        cut = max(3.0 * 1.4826 * np.median(resid[keep]), 6.0)
+        keep = resid < cut
+        if keep.sum() < 12:
+            keep = resid <= np.median(resid)
+    quad = (_design(gx.ravel(), gy.ravel()) @ coef).reshape(h, w, c).astype(np.float32)
+    resid_img = np.zeros((h, w, c), np.float32)
+    known = np.zeros((h, w), bool)
+    resid_img[ys[keep], xs[keep]] = (values - a_all @ coef)[keep]
+    known[ys[keep], xs[keep]] = True
+    model = quad + harmonic_fill(resid_img, known)
+    local = image - cv2.blur(image, (3, 3))
+    noise = np.maximum(1.4826 * np.median(np.abs(local[ys[keep], xs[keep]]), axis=0) * 3.0, 1.5)
+    return model, noise.astype(np.float32)
+
+
+def harmonic_fill(values: np.ndarray, known: np.ndarray, grid: int = 40, iterations: int = 200) -> np.ndarray:
+    """Smoothly interpolate H x W x C `values` from the `known` pixels to all others (Laplace equation solved
+    by Jacobi iterations on a coarse grid, then upsampled)."""
+    h, w = known.shape
+    gh, gw = max(2, round(grid * h / max(h, w))), max(2, round(grid * w / max(h, w)))
+    weight = cv2.resize(known.astype(np.float32), (gw, gh), interpolation=cv2.INTER_AREA)
+    vals = cv2.resize(values * known[..., None], (gw, gh), interpolation=cv2.INTER_AREA).reshape(gh, gw, -1)
+    fixed = weight > 0.25
+    vals[fixed] /= weight[fixed][:, None]
+    field = np.where(fixed[..., None], vals, 0.0).astype(np.float32)
+    for _ in range(iterations):
+        avg = cv2.blur(field, (3, 3), borderType=cv2.BORDER_REPLICATE).reshape(gh, gw, -1)
+        field = np.where(fixed[..., None], vals, avg)
+    out = cv2.resize(field, (w, h), interpolation=cv2.INTER_LINEAR)
+    return out.reshape(h, w, -1)
+
+
+def backdrop_distance(image: np.ndarray, band: np.ndarray) -> np.ndarray:
+    """H x W distance of each pixel from the fitted backdrop, in units of the border noise.
+
+    Shadows and light pools on the backdrop scale its colour by a common factor and carry no texture: where the
+    brightness ratio is in `LIGHT_RANGE`, the distance counted is the departure from the scaled backdrop colour
+    (chroma) plus the local texture, not the brightness change itself.
+
+    Args:
+        image: H x W x 3 uint8 RGB (detection scale).
+        band: H x W bool border band.
+    """
+    smooth = cv2.GaussianBlur(image, (0, 0), 1.2).astype(np.float32)
+    model, noise = fit_backdrop(smooth, band)
+    dist = np.sqrt((((smooth - model) / noise) ** 2).sum(axis=2))
+    ratio = (smooth * model).sum(2) / np.maximum((model * model).sum(2), 1.0)
+    chroma = np.sqrt((((smooth - ratio[..., None] * model) / noise) ** 2).sum(axis=2))
+    grey = smooth.mean(axis=2)
+    texture = np.hypot(cv2.Sobel(grey, cv2.CV_32F, 1, 0), cv2.Sobel(grey, cv2.CV_32F, 0, 1)) / (4 * noise.mean())
+    texture = cv2.GaussianBlur(texture, (0, 0), 2.0)
+    lighting = (ratio > LIGHT_RANGE[0]) & (ratio < LIGHT_RANGE[1])
+    return np.where(lighting, np.minimum(dist, 1.5 * chroma + 2.0 * texture), dist)
+
+
+def edge_map(image: np.ndarray) -> np.ndarray:
+    """H x W float edge strength in [0, 1] (Canny on the grey image, auto thresholds from the median)."""
+    grey = cv2.cvtColor(image, cv2.COLOR_RGB2GRAY)
+    grey = cv2.GaussianBlur(grey, (0, 0), 1.0)
+    med = float(np.median(grey))
+    edges = cv2.Canny(grey, max(5.0, 0.4 * med), max(15.0, 0.8 * med))
+    return cv2.GaussianBlur(edges.astype(np.float32) / 255.0, (0, 0), 1.5).clip(0, 1) * 2.0
+
+
+def saliency_map(image: np.ndarray) -> np.ndarray:
+    """H x W spectral-residual saliency in [0, 1] (opencv-contrib); zeros if the module is missing."""
+    sal = getattr(cv2, "saliency", None)
+    if sal is None:
+        return np.zeros(image.shape[:2], np.float32)
+    ok, smap = sal.StaticSaliencySpectralResidual_create().computeSaliency(image)
+    if not ok:
+        return np.zeros(image.shape[:2], np.float32)
+    smap = smap.astype(np.float32)
+    return smap / max(float(smap.max()), 1e-6)
+
+
+def foreground_evidence(image: np.ndarray) -> np.ndarray:
+    """H x W evidence in [0, 1] that a pixel is not backdrop: colour distance, plus edges and saliency near the
+    threshold (they can lift a low-contrast pixel over it, never create an object alone)."""
+    band = border_band(image.shape[:2])
+    dist = backdrop_distance(image, band)
+    colour = 1.0 - np.exp(-((dist / 6.0) ** 2))  # ~0.63 at 6 sigma
+    extra = 0.25 * edge_map(image).clip(0, 1) + 0.15 * saliency_map(image)
+    return np.clip(colour + extra * (colour > 0.15), 0.0, 1.0)
+
+
+def _clean(mask: np.ndarray) -> np.ndarray:
+    """Close small gaps, fill holes (flood from the border), open away specks."""
+    side = max(mask.shape)
+    k = max(3, (side // 80) | 1)
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))
+    m = cv2.morphologyEx(mask.astype(np.uint8), cv2.MORPH_CLOSE, kernel)
+    m = fill_holes(m > 0).astype(np.uint8)
+    return cv2.morphologyEx(m, cv2.MORPH_OPEN, kernel) > 0
+
+
+def fill_holes(mask: np.ndarray, max_hole_frac: float = 1.0) -> np.ndarray:
+    """Fill the holes of a bool mask that are at most `max_hole_frac` of the mask's area."""
+    m = mask.astype(np.uint8)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(1 - m, connectivity=4)
+    h, w = m.shape
+    out = mask.copy()
+    limit = max_hole_frac * max(int(m.sum()), 1)
+    for i in range(1, n):
+        x, y, bw, bh, area = stats[i]
+        touches = x == 0 or y == 0 or x + bw == w or y + bh == h
+        if not touches and area <= limit:
+            out[labels == i] = True
+    return out
+
+
+def _groups(boxes: list[tuple[int, int, int, int]], gap: float) -> list[list[int]]:
+    """Indices of boxes (x0, y0, x1, y1) grouped transitively when they come within `gap` px of each other:
+    the pieces of one object that the threshold split apart."""
+    group = list(range(len(boxes)))
+
+    def root(i: int) -> int:
+        while group[i] != i:
+            i = group[i]
+        return i
+
+    for i, a in enumerate(boxes):
+        for j in range(i):
+            b = boxes[j]
+            if a[0] - gap < b[2] and b[0] - gap < a[2] and a[1] - gap < b[3] and b[1] - gap < a[3]:
+                group[root(i)] = root(j)
+    out: dict[int, list[int]] = {}
+    for i in range(len(boxes)):
+        out.setdefault(root(i), []).append(i)
+    return list(out.values())
+
+
+def detect(image: np.ndarray, threshold: float = 0.5) -> list[Detection]:
+    """Find the objects in a studio photograph.
+
+    Args:
+        image: H x W x 3 uint8 RGB, any size (it is downscaled to `WORK_SIDE` here).
+        threshold: evidence level that separates object from backdrop.
+
+    Returns:
+        Detections, largest first; empty if nothing stands out from the backdrop.
+    """
+    small, scale = downscale(image)
+    evidence = foreground_evidence(small)
+    mask = _clean(evidence > threshold)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
+    if n <= 1:
+        return []
+    areas = stats[1:, cv2.CC_STAT_AREA]
+    min_area = max(MIN_AREA_FRAC * mask.size, MIN_REL_AREA * areas.max())
+    big = [i + 1 for i in range(n - 1) if areas[i] >= min_area]
+    boxes = [(stats[i, 0], stats[i, 1], stats[i, 0] + stats[i, 2], stats[i, 1] + stats[i, 3]) for i in big]
+    found = []
+    for members in _groups(boxes, GROUP_GAP * max(mask.shape)):
+        comp = np.isin(labels, [big[k] for k in members])
+        ys, xs = np.nonzero(comp)
+        box = (xs.min() / scale, ys.min() / scale, (xs.max() + 1) / scale, (ys.max() + 1) / scale)
+        found.append(Detection(comp, box, float(evidence[comp].mean()), scale))
+    return sorted(found, key=lambda d: -int(d.mask.sum()))

@@ -1,0 +1,154 @@
+"""One photograph -> its object crops: load (fast, downscaled JPEG decode), detect, refine, crop, score."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+from PIL import Image, ImageOps
+
+from radar_cli.errors import InputError
+from radar_cli.fileio import read_image
+from radar_cli.masks import crop as crops
+from radar_cli.masks.detect import Detection, detect
+from radar_cli.masks.quality import Thresholds, judge, score_mask
+from radar_cli.masks.refine import refine
+
+MIN_PHOTO_SIDE = 64  # photos smaller than this (short edge) cannot give a useful crop
+REFINE_PAD = 1.3  # the refinement window is this much larger than the final crop, so GrabCut sees backdrop
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How crops are made and judged."""
+
+    size: int = 256
+    """Side of the output crops in pixels."""
+    margin: float = crops.DEFAULT_MARGIN
+    """Per-side margin as a fraction of the crop (the object spans 1 - 2 * margin of the crop)."""
+    limits: Thresholds = field(default_factory=Thresholds)
+
+
+@dataclass(frozen=True)
+class Crop:
+    """One object's crop.
+
+    Attributes:
+        image: size x size x 3 uint8 RGB.
+        mask: size x size bool silhouette.
+        box: the crop window in the (decoded) photo's pixels, plus `photo_scale`: decoded / original pixels.
+        scores: quality scores (area, touches_border, solidity, symmetry) and `detector`, `grabcut`.
+        reasons: why it is rejected; empty if accepted.
+    """
+
+    image: np.ndarray
+    mask: np.ndarray
+    box: crops.CropBox
+    photo_scale: float
+    scores: dict
+    reasons: list[str]
+
+    @property
+    def accepted(self) -> bool:
+        return not self.reasons
+
+    def original_box(self) -> list[float]:
+        """The crop window [x0, y0, side] in the ORIGINAL photo's pixels."""
+        s = self.photo_scale
+        return [round(self.box.x0 / s, 1), round(self.box.y0 / s, 1), round(self.box.side / s, 1)]
+
+
+def load_photo(path: str | Path, min_long_side: int = 1024) -> tuple[np.ndarray, float, tuple[int, int]]:
+    """Read a photo as H x W x 3 uint8 RGB; big JPEGs are decoded at 1/2, 1/4 or 1/8 scale (DCT draft) when
+    that still leaves a long edge >= `min_long_side`.
+
+    Returns:
+        (image, scale = decoded pixels per original pixel, original (width, height)).
+    """
+    path = Path(path)
+    try:
+        with Image.open(path) as im:
+            original = im.size
+            if im.format != "JPEG":
+                raise _NotJpeg
+            want = min_long_side / max(original)
+            if want < 0.5:
+                im.draft("RGB", (max(1, int(original[0] * want)), max(1, int(original[1] * want))))
+            im = ImageOps.exif_transpose(im)
+            rgb = np.asarray(im.convert("RGB")).copy()
+            return rgb, _decoded_scale(rgb, original), original
+    except _NotJpeg:
+        image = read_image(path, "RGB")
+        return image, 1.0, (image.shape[1], image.shape[0])
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except Image.DecompressionBombError as e:
+        raise InputError(f"{path}: image too large ({e})") from None
+    except (OSError, ValueError, SyntaxError) as e:
+        raise InputError(f"{path}: not a readable image ({e})") from None
+
+
+class _NotJpeg(Exception):
+    pass
+
+
+def _decoded_scale(rgb: np.ndarray, original: tuple[int, int]) -> float:
+    """Decoded pixels per original pixel, whatever the EXIF rotation did to the axes."""
+    return max(rgb.shape[:2]) / max(original)
+
+
+def check_photo(image: np.ndarray, name: str) -> None:
+    """Raise InputError if a photo cannot give a crop (too small, or one flat colour)."""
+    h, w = image.shape[:2]
+    if min(h, w) < MIN_PHOTO_SIDE:
+        raise InputError(f"{name}: image too small ({w} x {h} px, need >= {MIN_PHOTO_SIDE})")
+    if int(image.max()) - int(image.min()) < 8:
+        raise InputError(f"{name}: image is a flat colour, nothing to segment")
+
+
+def crop_detection(image: np.ndarray, found: Detection, settings: Settings) -> Crop:
+    """Refine one detection at crop resolution and cut the final, scored crop.
+
+    Args:
+        image: H x W x 3 uint8 (the decoded photo the detection's box refers to).
+        found: a detection in that photo.
+        settings: sizes and thresholds.
+    """
+    work_side = int(round(settings.size * REFINE_PAD))
+    fill_margin = 0.5 - (1.0 - 2.0 * settings.margin) / (2.0 * REFINE_PAD)
+    window = crops.square_box(found.box, fill_margin)
+    work_img = crops.cut(image, window, work_side)
+    rough = crops.warp_mask(found.mask, crops.crop_affine(window, work_side, found.scale), work_side)
+    mask, used_grabcut = refine(work_img, rough)
+    box = crops.mask_box(mask)
+    if box is None:
+        box, mask = crops.mask_box(rough) or (0, 0, work_side, work_side), rough
+    k = window.side / work_side  # photo pixels per work pixel
+    photo_box = (window.x0 + box[0] * k, window.y0 + box[1] * k, window.x0 + box[2] * k, window.y0 + box[3] * k)
+    final = crops.square_box(photo_box, settings.margin)
+    out_img = crops.cut(image, final, settings.size)
+    to_final = crops.crop_affine(final, settings.size, 1.0 / k) @ np.vstack(
+        [[1, 0, window.x0 / k], [0, 1, window.y0 / k], [0, 0, 1]])
+    out_mask = crops.warp_mask(mask, to_final, settings.size)
+    scores = score_mask(out_mask, crops.valid_region(final, image.shape, settings.size))
+    scores.update(detector=round(found.score, 4), grabcut=used_grabcut)
+    return Crop(out_img, out_mask, final, 1.0, scores, judge(scores, settings.limits))
+
+
+Detector = Callable[[np.ndarray], list[Detection]]
+
+
+def process_image(image: np.ndarray, settings: Settings, detector: Detector = detect,
+                  name: str = "image") -> list[Crop]:
+    """All object crops of one decoded photo (H x W x 3 uint8); InputError if it cannot give any."""
+    check_photo(image, name)
+    return [crop_detection(image, found, settings) for found in detector(image)]
+
+
+def process_photo(path: str | Path, settings: Settings, detector: Detector = detect) -> list[Crop]:
+    """Load a photo file and return its crops, with crop boxes in the original photo's pixels."""
+    image, scale, _ = load_photo(path, min_long_side=max(768, 3 * settings.size))
+    found = process_image(image, settings, detector, str(path))
+    return [Crop(c.image, c.mask, c.box, scale, c.scores, c.reasons) for c in found]

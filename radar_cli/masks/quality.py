@@ -1,0 +1,149 @@
+"""Quality scores of a crop's silhouette and the thresholds that accept or reject it.
+
+The solid-of-revolution score replaces the paper's manual filtering: a solid of revolution seen from the side
+(pitch 0..20 deg, small roll) has a silhouette that is its own mirror image about the projected axis, and each
+row of it is one interval centred on that axis. Spouts and figurines break the mirror; handles leave gaps that a
+per-row half-width profile cannot explain.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+SCORE_SIDE = 96  # scores are computed on the mask resized to this side: fast and resolution-independent
+TILTS_DEG = (-12.0, -8.0, -4.0, 0.0, 4.0, 8.0, 12.0)  # axis tilts searched (the network's roll is +-10 deg)
+
+
+@dataclass(frozen=True)
+class Thresholds:
+    """Acceptance limits of a crop (a crop failing any one is rejected with that reason)."""
+
+    min_area: float = 0.08
+    """Smallest mask area as a fraction of the crop."""
+    max_area: float = 0.85
+    """Largest mask area: beyond it the 'object' is probably the backdrop."""
+    min_solidity: float = 0.6
+    """Mask area over its convex hull's area."""
+    min_symmetry: float = 0.8
+    """Solid-of-revolution score (see `sor_score`)."""
+    allow_border: bool = False
+    """Accept objects cut off by the photo's edge."""
+
+
+def solidity(mask: np.ndarray) -> float:
+    """Area of a bool mask over the area of its convex hull (0 for an empty mask)."""
+    pts = cv2.findNonZero(mask.astype(np.uint8))
+    if pts is None:
+        return 0.0
+    hull = cv2.convexHull(pts)
+    hull_area = cv2.contourArea(hull) + 0.5 * cv2.arcLength(hull, True) + 1.0  # pixel areas, not polygon
+    return float(min(1.0, mask.sum() / hull_area))
+
+
+def touches(mask: np.ndarray, region: tuple[int, int, int, int]) -> bool:
+    """True if the mask reaches the edge of `region` (u0, v0, u1, v1) where that edge is the photo's edge."""
+    u0, v0, u1, v1 = region
+    if u1 <= u0 or v1 <= v0:
+        return bool(mask.any())
+    inner = mask[v0:v1, u0:u1]
+    return bool(inner[0].any() or inner[-1].any() or inner[:, 0].any() or inner[:, -1].any())
+
+
+def _rotate(mask: np.ndarray, deg: float) -> np.ndarray:
+    if deg == 0:
+        return mask
+    h, w = mask.shape
+    ys, xs = np.nonzero(mask)
+    centre = (float(xs.mean()), float(ys.mean()))
+    rot = cv2.getRotationMatrix2D(centre, deg, 1.0)
+    return cv2.warpAffine(mask.astype(np.uint8), rot, (w, h), flags=cv2.INTER_NEAREST) > 0
+
+
+def mirror_agreement(mask: np.ndarray) -> tuple[float, float]:
+    """Best IoU of a bool mask with its mirror image about a vertical axis (searched at half-pixel steps).
+
+    Returns:
+        (iou, axis x in pixels).
+    """
+    area = int(mask.sum())
+    if area == 0:
+        return 0.0, 0.0
+    w = mask.shape[1]
+    cols = mask.sum(0).astype(np.float64)
+    centre = float((cols * np.arange(w)).sum() / area)
+    flipped = mask[:, ::-1]
+    best, best_axis = 0.0, centre
+    # mirror about x = a maps x to 2a - x; flipped[x] = mask[w-1-x], so shift k = round(2a - (w - 1))
+    k0 = int(round(2 * centre - (w - 1)))
+    for k in range(k0 - 4, k0 + 5):
+        shifted = np.zeros_like(mask)
+        if k >= 0:
+            shifted[:, k:] = flipped[:, : w - k]
+        else:
+            shifted[:, :k] = flipped[:, -k:]
+        inter = np.logical_and(mask, shifted).sum()
+        score = inter / (2 * area - inter)
+        if score > best:
+            best, best_axis = float(score), (k + w - 1) / 2.0
+    return best, best_axis
+
+
+def profile_agreement(mask: np.ndarray, axis: float) -> float:
+    """IoU of a bool mask with the solid it implies: each row filled symmetrically about `axis` out to the row's
+    mean extent. Gaps within a row (handles) and lopsided rows lower it."""
+    xs = np.arange(mask.shape[1])
+    rows = np.nonzero(mask.any(1))[0]
+    implied = np.zeros_like(mask)
+    for y in rows:
+        cols = xs[mask[y]]
+        half = 0.5 * ((axis - cols.min()) + (cols.max() - axis))
+        implied[y] = np.abs(xs - axis) <= max(half, 0.5)
+    inter = np.logical_and(mask, implied).sum()
+    union = np.logical_or(mask, implied).sum()
+    return float(inter / union) if union else 0.0
+
+
+def sor_score(mask: np.ndarray) -> float:
+    """Solid-of-revolution score in [0, 1]: the product of mirror and profile agreement about the best
+    vertical axis, the best over small axis tilts."""
+    m = cv2.resize(mask.astype(np.uint8), (SCORE_SIDE, SCORE_SIDE), interpolation=cv2.INTER_AREA) > 0
+    if m.sum() < 10:
+        return 0.0
+    best = 0.0
+    for deg in TILTS_DEG:
+        r = _rotate(m, deg)
+        mirror, axis = mirror_agreement(r)
+        if mirror <= best:
+            continue
+        best = max(best, mirror * profile_agreement(r, axis))
+    return best
+
+
+def score_mask(mask: np.ndarray, region: tuple[int, int, int, int] | None = None) -> dict[str, float | bool]:
+    """All quality scores of a crop's bool mask; `region` is the part of the crop inside the photo."""
+    region = region or (0, 0, mask.shape[1], mask.shape[0])
+    return {
+        "area": round(float(mask.mean()), 4),
+        "touches_border": touches(mask, region),
+        "solidity": round(solidity(mask), 4),
+        "symmetry": round(sor_score(mask), 4),
+    }
+
+
+def judge(scores: dict, limits: Thresholds) -> list[str]:
+    """The reasons a crop is rejected (empty list = accepted)."""
+    reasons = []
+    if scores["area"] < limits.min_area:
+        reasons.append(f"area {scores['area']:.3f} < {limits.min_area}")
+    if scores["area"] > limits.max_area:
+        reasons.append(f"area {scores['area']:.3f} > {limits.max_area}")
+    if scores["touches_border"] and not limits.allow_border:
+        reasons.append("object touches the photo's edge")
+    if scores["solidity"] < limits.min_solidity:
+        reasons.append(f"solidity {scores['solidity']:.2f} < {limits.min_solidity}")
+    if scores["symmetry"] < limits.min_symmetry:
+        reasons.append(f"symmetry {scores['symmetry']:.2f} < {limits.min_symmetry}")
+    return reasons

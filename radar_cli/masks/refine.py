@@ -1,0 +1,89 @@
+"""GrabCut refinement of a rough object mask at crop resolution, then clean-up: holes, main part, smooth edge."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from radar_cli.masks.detect import fill_holes
+
+INNER_BAND = 0.05  # probable-foreground band inside the rough mask, as a fraction of the object's size
+OUTER_BAND = 0.08  # probable-background band outside it
+MAX_HOLE_FRAC = 0.01  # holes up to this fraction of the object are noise and get filled; larger ones are real
+MIN_AGREEMENT = 0.6  # GrabCut results this unlike the rough mask (IoU) are distrusted
+
+
+def iou(a: np.ndarray, b: np.ndarray) -> float:
+    """Intersection over union of two bool masks (1.0 if both are empty)."""
+    union = np.logical_or(a, b).sum()
+    return float(np.logical_and(a, b).sum() / union) if union else 1.0
+
+
+def _disk(radius: int) -> np.ndarray:
+    d = 2 * max(1, radius) + 1
+    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (d, d))
+
+
+def trimap(rough: np.ndarray) -> np.ndarray:
+    """GrabCut's 4-level mask from a rough bool mask: definite foreground deep inside, probable foreground and
+    probable background in bands either side of the outline, definite background beyond."""
+    m = rough.astype(np.uint8)
+    size = np.sqrt(max(int(m.sum()), 1))
+    inner = cv2.erode(m, _disk(round(INNER_BAND * size))) > 0
+    outer = cv2.dilate(m, _disk(round(OUTER_BAND * size))) > 0
+    tri = np.full(m.shape, cv2.GC_BGD, np.uint8)
+    tri[outer] = cv2.GC_PR_BGD
+    tri[rough] = cv2.GC_PR_FGD
+    tri[inner] = cv2.GC_FGD
+    return tri
+
+
+def main_component(mask: np.ndarray) -> np.ndarray:
+    """The largest 8-connected component of a bool mask."""
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
+    if n <= 2:
+        return mask.astype(bool)
+    return labels == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+
+
+def smooth_boundary(mask: np.ndarray, sigma: float) -> np.ndarray:
+    """Blur the 0/1 mask and cut at 0.5: removes pixel staircases and one-pixel spurs, keeps the shape."""
+    if sigma <= 0:
+        return mask
+    return cv2.GaussianBlur(mask.astype(np.float32), (0, 0), sigma) > 0.5
+
+
+def clean(mask: np.ndarray, sigma: float) -> np.ndarray:
+    """Fill small holes, keep the main component, smooth the outline."""
+    m = main_component(fill_holes(mask, MAX_HOLE_FRAC))
+    return main_component(smooth_boundary(m, sigma))
+
+
+def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4) -> tuple[np.ndarray, bool]:
+    """Refine a rough mask with GrabCut.
+
+    Args:
+        image: S x S x 3 uint8 RGB crop.
+        rough: S x S bool rough mask (from the detector, warped into the crop).
+        iterations: GrabCut iterations.
+
+    Returns:
+        (mask S x S bool, used_grabcut): the cleaned mask; False if GrabCut failed or disagreed with the
+        rough mask so much that the rough mask was kept (still cleaned).
+    """
+    sigma = max(0.6, image.shape[0] / 256.0)
+    if rough.sum() < 16:
+        return clean(rough, sigma), False
+    tri = trimap(rough)
+    if not (tri == cv2.GC_FGD).any() or not (tri == cv2.GC_BGD).any():
+        return clean(rough, sigma), False
+    bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
+    try:
+        cv2.grabCut(np.ascontiguousarray(image), tri, None, bgd, fgd, iterations, cv2.GC_INIT_WITH_MASK)
+    except cv2.error:
+        return clean(rough, sigma), False
+    cut = (tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)
+    refined = clean(cut, sigma)
+    if iou(refined, rough) < MIN_AGREEMENT:
+        return clean(rough, sigma), False
+    return refined, True
