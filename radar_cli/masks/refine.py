@@ -59,6 +59,35 @@ def clean(mask: np.ndarray, sigma: float) -> np.ndarray:
     return main_component(smooth_boundary(m, sigma))
 
 
+def snap_edges(image: np.ndarray, mask: np.ndarray, band: int = 2, sigma: float = 3.0) -> np.ndarray:
+    """Decide the outline pixels by their coverage: GrabCut keeps mixed pixels whole, which puts the outline
+    about a pixel outside the true edge. A pixel within `band` px of the outline gets alpha from projecting its
+    colour between the local foreground and background means; it is object if alpha > 0.5.
+
+    Args:
+        image: S x S x 3 uint8. mask: S x S bool.
+    """
+    m = mask.astype(np.uint8)
+    k = _disk(band)
+    inner = cv2.erode(m, k).astype(np.float32)
+    outer = (1 - cv2.dilate(m, k)).astype(np.float32)
+    ring = (cv2.dilate(m, k) > 0) & ~(inner > 0)
+    img = image.astype(np.float32)
+
+    def local_mean(weight: np.ndarray) -> np.ndarray:
+        w = cv2.GaussianBlur(weight, (0, 0), sigma)
+        return cv2.GaussianBlur(img * weight[..., None], (0, 0), sigma) / np.maximum(w, 1e-3)[..., None]
+
+    fg, bg = local_mean(inner), local_mean(outer)
+    span = fg - bg
+    alpha = ((img - bg) * span).sum(2) / np.maximum((span * span).sum(2), 1e-3)
+    contrast = np.sqrt((span * span).sum(2)) > 12.0  # where fg and bg look alike, keep GrabCut's answer
+    out = mask.copy()
+    decide = ring & contrast
+    out[decide] = alpha[decide] > 0.5
+    return out
+
+
 def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4) -> tuple[np.ndarray, bool]:
     """Refine a rough mask with GrabCut.
 
@@ -82,7 +111,7 @@ def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4) -> tuple[n
         cv2.grabCut(np.ascontiguousarray(image), tri, None, bgd, fgd, iterations, cv2.GC_INIT_WITH_MASK)
     except cv2.error:
         return clean(rough, sigma), False
-    cut = (tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)
+    cut = snap_edges(image, (tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD))
     refined = clean(cut, sigma)
     if iou(refined, rough) < MIN_AGREEMENT:
         return clean(rough, sigma), False
