@@ -14,6 +14,7 @@ from radar_cli.errors import RadarError
 # (module, command attribute): one line per working subcommand.
 COMMANDS: list[tuple[str, str]] = [
     ("radar_cli.cli.fetch", "fetch"),
+    ("radar_cli.cli.masks", "masks"),
 ]
 
 
