@@ -1,0 +1,173 @@
+"""Tests of the masks pipeline: detection + GrabCut accuracy on composites, crops, SoR score, batch driver."""
+
+from __future__ import annotations
+
+import json
+import struct
+import zlib
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from PIL import Image
+
+from radar_cli.cli import cli
+from radar_cli.errors import InputError
+from radar_cli.masks import crop as crops
+from radar_cli.masks.pipeline import Settings, process_image
+from radar_cli.masks.prepare import prepare, split_for
+from radar_cli.masks.quality import Thresholds, score_mask, sor_score
+from radar_cli.masks.refine import iou
+from radar_cli.masks.synthetic import NON_SOR, composite, non_sor_mask, render_vases, sor_mask
+
+REAL = Path(__file__).resolve().parents[3] / "shared" / "data" / "real_vases"
+
+
+@pytest.fixture(scope="module")
+def vases():
+    return render_vases(3, 128, seed=3)
+
+
+def _crop_iou(photo: np.ndarray, truth: np.ndarray) -> float:
+    found = process_image(photo, Settings())
+    assert found, "nothing detected"
+    best = max(found, key=lambda c: int(c.mask.sum()))
+    return iou(best.mask, crops.cut(truth.astype(np.float32), best.box, 256) > 0.5)
+
+
+@pytest.mark.parametrize("kind,floor", [("plain", 0.95), ("gradient", 0.95), ("textured", 0.85),
+                                        ("label", 0.93)])
+def test_composite_iou(vases, kind, floor):
+    image, alpha, mask = vases
+    rng = np.random.default_rng(5)
+    scores = [_crop_iou(*composite(image[i], alpha[i], mask[i], kind, rng)) for i in range(3)]
+    assert np.mean(scores) >= floor, scores
+
+
+def test_crop_geometry_object_fills_085():
+    mask = np.zeros((400, 300), bool)
+    mask[100:300, 120:180] = True  # 200 tall, 60 wide
+    box = crops.square_box(crops.mask_box(mask))
+    assert box.side == round(200 / 0.85)
+    out = crops.cut(mask.astype(np.float32), box, 128) > 0.5
+    warped = crops.warp_mask(mask, crops.crop_affine(box, 128), 128)
+    assert iou(out, warped) > 0.97
+    ys = np.nonzero(out.any(1))[0]
+    assert abs((ys.max() - ys.min() + 1) / 128 - 0.85) < 0.02
+
+
+def test_crop_pads_outside_the_photo():
+    img = np.full((50, 50, 3), 7, np.uint8)
+    out = crops.cut(img, crops.CropBox(-20, -20, 100), 64)
+    assert out.shape == (64, 64, 3) and (out == 7).all()
+    assert crops.valid_region(crops.CropBox(-20, -20, 100), img.shape, 100) == (20, 20, 70, 70)
+
+
+def test_symmetry_separates_sor_from_other_shapes():
+    rng = np.random.default_rng(11)
+    limit = Thresholds().min_symmetry
+    sor = [sor_score(sor_mask(128, rng)) >= limit for _ in range(25)]
+    other = [sor_score(non_sor_mask(NON_SOR[i % len(NON_SOR)], 128, rng)) < limit for i in range(25)]
+    assert np.mean(sor + other) >= 0.9
+
+
+def test_rendered_vase_scores(vases):
+    for m in vases[2]:
+        s = score_mask(m)
+        assert s["symmetry"] >= Thresholds().min_symmetry and s["solidity"] > 0.6 and not s["touches_border"]
+
+
+def test_split_is_deterministic_and_roughly_78_percent():
+    splits = [split_for(f"met_{i}") for i in range(2000)]
+    assert splits == [split_for(f"met_{i}") for i in range(2000)]
+    assert 0.74 < splits.count("train") / 2000 < 0.82
+
+
+def _png_claiming(width: int, height: int) -> bytes:
+    """A PNG header announcing a huge image, with no pixel data (decompression-bomb probe)."""
+    def chunk(tag: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data))
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
+
+
+def _studio(rng: np.random.Generator, size=(240, 200)) -> np.ndarray:
+    h, w = size
+    img = np.full((h, w, 3), 200, np.uint8)
+    m = cv2.resize(sor_mask(128, rng).astype(np.uint8), (int(h * 0.7), int(h * 0.7))) > 0
+    top, left = int(h * 0.15), (w - m.shape[1]) // 2
+    img[top : top + m.shape[0], left : left + m.shape[1]][m] = (120, 60, 30)
+    return img
+
+
+def _bad_folder(folder: Path) -> None:
+    rng = np.random.default_rng(0)
+    good = _studio(rng)
+    Image.fromarray(good).save(folder / "good.jpg")
+    Image.fromarray(good).convert("L").save(folder / "grey.png")
+    Image.fromarray(good).convert("RGBA").save(folder / "rgba.png")
+    Image.fromarray(good).convert("CMYK").save(folder / "cmyk.jpg")
+    Image.fromarray((good[..., 0].astype(np.uint16) * 257)).save(folder / "sixteen.png")
+    (folder / "corrupt.jpg").write_bytes(b"not an image at all")
+    data = (folder / "good.jpg").read_bytes()
+    (folder / "truncated.jpg").write_bytes(data[: len(data) // 3])
+    Image.fromarray(good[:20, :20]).save(folder / "tiny.png")
+    Image.fromarray(np.full((100, 100, 3), 128, np.uint8)).save(folder / "flat.png")
+    (folder / "huge.png").write_bytes(_png_claiming(30000, 30000))
+
+
+def test_bad_inputs_are_recorded_and_the_batch_goes_on(tmp_path):
+    src = tmp_path / "photos"
+    src.mkdir()
+    _bad_folder(src)
+    result = CliRunner().invoke(cli, ["masks", str(src), "--out", str(tmp_path / "out")])
+    assert result.exit_code == 1, result.output
+    records = {p.stem: json.loads(p.read_text()) for p in (tmp_path / "out" / ".records").glob("*.json")}
+    assert len(records) == 10
+    for key in ("good", "grey", "rgba", "cmyk", "sixteen"):
+        assert records[key]["status"] == "done" and records[key]["crops"], key
+    for key in ("corrupt", "tiny", "flat", "huge"):
+        assert records[key]["status"] == "failed" and f"{key}." in records[key]["reason"], records[key]
+    assert records["truncated"]["status"] in ("failed", "done")
+    failures = (tmp_path / "out" / "failures.csv").read_text()
+    assert "corrupt.jpg" in failures and "huge.png" in failures and "too small" in failures
+    samples = list((tmp_path / "out").glob("*/*/image.png"))
+    assert samples and all((p.parent / "mask.png").is_file() and (p.parent / "meta.json").is_file()
+                           for p in samples)
+    assert (tmp_path / "out" / "contact_sheet-001.png").is_file()
+
+
+def test_resume_skips_finished_photos(tmp_path):
+    src = tmp_path / "photos"
+    src.mkdir()
+    rng = np.random.default_rng(1)
+    for i in range(3):
+        Image.fromarray(_studio(rng)).save(src / f"vase{i}.png")
+    first = prepare(src, tmp_path / "out", progress=False, contact_sheet=False)
+    assert first.photos == 3 and sum(first.accepted.values()) + first.rejected == 3, first
+    meta = json.loads(next((tmp_path / "out").glob("*/vase0/meta.json")).read_text())
+    assert meta["source"].endswith("vase0.png") and len(meta["crop_box"]) == 3 and "symmetry" in meta["scores"]
+    Image.fromarray(_studio(rng)).save(src / "vase3.png")
+    second = prepare(src, tmp_path / "out", progress=False, contact_sheet=False, workers=2)
+    assert second.skipped_done == 3 and second.photos == 4
+
+
+def test_onnx_detector_reports_missing_runtime_or_bad_model(tmp_path):
+    from radar_cli.masks.onnx import OnnxDetector
+
+    bad = tmp_path / "m.onnx"
+    bad.write_bytes(b"junk")
+    with pytest.raises(InputError):
+        OnnxDetector(bad)
+
+
+@pytest.mark.skipif(not REAL.is_dir(), reason="real photos not present")
+def test_real_photos_give_one_plausible_crop_each():
+    from radar_cli.masks.pipeline import process_photo
+
+    for name in ("met_gr_DP117199.jpg", "met_gr_DP107639.jpg"):
+        found = process_photo(REAL / name, Settings())
+        assert len(found) == 1
+        s = found[0].scores
+        assert 0.2 < s["area"] < 0.6 and s["symmetry"] > 0.8, s
