@@ -135,13 +135,17 @@ class Catalog:
                         (state, reason, _now(), object_id))
 
     def mark_changed(self, object_ids: Iterable[int]) -> int:
-        """Send known objects whose record changed back to `searched` (image facts kept). Returns the count."""
+        """Send known objects whose record changed back to `searched`. Returns the count.
+
+        The image URL is cleared (so a failed refetch retries the record), the stored image's path, hash and
+        ETag are kept (so an unchanged image is confirmed by a conditional GET instead of downloaded again).
+        """
         n = 0
         with self.db:
             self.db.execute("BEGIN")
             for object_id in object_ids:
                 n += self.db.execute(
-                    "UPDATE objects SET state = 'searched', reason = '', updated_at = ? "
+                    "UPDATE objects SET state = 'searched', reason = '', image_url = NULL, updated_at = ? "
                     "WHERE object_id = ? AND state != 'searched'", (_now(), int(object_id))).rowcount
         return n
 

@@ -12,7 +12,10 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[2]
-FETCH = "from radar_cli.cli.fetch import fetch; fetch()"  # the command alone, without the other subcommands
+# The `fetch` command module loaded by path: importing radar_cli.cli would import every other subcommand
+# (torch included, seconds per process on 2 busy cores) for nothing.
+FETCH = ("import importlib.util as u; s = u.spec_from_file_location('fetch', 'radar_cli/cli/fetch.py'); "
+         "m = u.module_from_spec(s); s.loader.exec_module(m); m.fetch()")
 N = 40
 
 
@@ -69,3 +72,20 @@ def test_sigkill_then_resume_equals_uninterrupted_run(met_server, tmp_path):
     assert (rows, files) == snapshot(clean)
     assert len(rows) == N and sum(name.endswith(".jpg") for name in files) == 36
     assert not [p for p in killed.rglob("*") if ".tmp" in p.name]  # no partial files left
+
+
+def test_ctrl_c_prints_a_summary_and_exits_130(met_server, tmp_path):
+    for i in range(1, 21):
+        met_server.add(i)
+    met_server.delay = 0.02
+    proc = subprocess.Popen(command(met_server, tmp_path / "data"), cwd=REPO, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 30
+    while met_server.hits("/api/v1/objects/5") == 0:
+        assert proc.poll() is None and time.monotonic() < deadline
+        time.sleep(0.005)
+    proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=30)
+    assert proc.returncode == 130, stderr
+    assert "[interrupted: rerun to resume]" in stdout and "found 20" in stdout
+    assert "Traceback" not in stderr
