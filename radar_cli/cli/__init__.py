@@ -15,6 +15,7 @@ from radar_cli.errors import RadarError
 COMMANDS: list[tuple[str, str]] = [
     ("radar_cli.cli.fetch", "fetch"),
     ("radar_cli.cli.masks", "masks"),
+    ("radar_cli.cli.synth", "synth"),
 ]
 
 
