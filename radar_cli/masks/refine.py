@@ -10,6 +10,7 @@ from radar_cli.masks.detect import fill_holes
 INNER_BAND = 0.05  # probable-foreground band inside the rough mask, as a fraction of the object's size
 OUTER_BAND = 0.08  # probable-background band outside it
 MAX_HOLE_FRAC = 0.01  # holes up to this fraction of the object are noise and get filled; larger ones are real
+GRABCUT_SIDE = 192  # GrabCut runs at most at this side (its cost dominates); edges are snapped at full size
 MIN_AGREEMENT = 0.6  # GrabCut results this unlike the rough mask (IoU) are distrusted
 
 
@@ -103,15 +104,21 @@ def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4) -> tuple[n
     sigma = max(0.6, image.shape[0] / 256.0)
     if rough.sum() < 16:
         return clean(rough, sigma), False
-    tri = trimap(rough)
+    side = image.shape[0]
+    small = min(1.0, GRABCUT_SIDE / side)
+    gc_img = cv2.resize(image, None, fx=small, fy=small, interpolation=cv2.INTER_AREA) if small < 1 else image
+    gc_rough = cv2.resize(rough.astype(np.uint8), gc_img.shape[1::-1], interpolation=cv2.INTER_NEAREST) > 0
+    tri = trimap(gc_rough)
     if not (tri == cv2.GC_FGD).any() or not (tri == cv2.GC_BGD).any():
         return clean(rough, sigma), False
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
     try:
-        cv2.grabCut(np.ascontiguousarray(image), tri, None, bgd, fgd, iterations, cv2.GC_INIT_WITH_MASK)
+        cv2.grabCut(np.ascontiguousarray(gc_img), tri, None, bgd, fgd, iterations, cv2.GC_INIT_WITH_MASK)
     except cv2.error:
         return clean(rough, sigma), False
-    cut = snap_edges(image, (tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD))
+    cut = ((tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)).astype(np.float32)
+    cut = cv2.resize(cut, (side, side), interpolation=cv2.INTER_LINEAR) > 0.5
+    cut = snap_edges(image, cut, band=max(2, round(1.5 / small)))
     refined = clean(cut, sigma)
     if iou(refined, rough) < MIN_AGREEMENT:
         return clean(rough, sigma), False
