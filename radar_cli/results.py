@@ -28,6 +28,22 @@ INDEX_FILE = "index.html"
 SUMMARY_FILE = "summary.csv"
 FAILURES_FILE = "failures.csv"
 
+# exports written by radar_cli.derender (not needed by `radar eval`)
+RECON_FILE = "recon.png"
+ALBEDO_FILE = "albedo.png"  # 360 deg unwrapped albedo, tone-mapped; the meshes' texture; relight reads it
+TEXTURE_FILE = "texture.png"
+NORMAL_FILE = "normal.png"
+DIFFUSE_FILE = "diffuse.png"
+SPECULAR_FILE = "specular.png"
+ENV_HDR_FILE = "env_map.hdr"
+ENV_PREVIEW_FILE = "env_map.png"
+MESH_GLB_FILE = "mesh.glb"
+MESH_OBJ_FILE = "mesh.obj"
+MATERIAL_SPHERE_FILE = "material_sphere.png"
+TURNTABLE_GIF_FILE = "turntable.gif"
+TURNTABLE_STRIP_FILE = "turntable.png"
+RELIT_PREFIX = "relit_"  # relit_<environment>.png
+
 # material.json keys that `radar eval` reads (others may be present)
 MATERIAL_KEYS = ("pitch", "roll", "tx", "ty", "height", "radius", "alpha", "rho")
 

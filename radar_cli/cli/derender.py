@@ -1,0 +1,52 @@
+"""`radar derender`: de-render photographs into per-object folders with meshes, maps, renders and a gallery."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from radar_cli.derender.batch import DerenderOptions, derender as run_derender
+from radar_cli.derender.contact_sheet import contact_sheet as write_contact_sheet
+from radar_cli.derender.export import ExportConfig
+from radar_cli.derender.predictor import Predictor
+
+
+@click.command("derender")
+@click.argument("inputs", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.option("--out", required=True, type=click.Path(file_okay=False, path_type=Path),
+              help="Results folder: one sub-folder per object, plus index.html, summary.csv, failures.csv.")
+@click.option("--checkpoint", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Model weights (.safetensors); default: the bundled model.")
+@click.option("--masks", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="Folder of known silhouettes (<stem>.png or <stem>/mask.png) used to crop.")
+@click.option("--crop", type=click.Choice(["auto", "none"]), default="auto", show_default=True,
+              help="auto: locate and crop the object in photos that are not square; none: pad to a square.")
+@click.option("--device", default="auto", show_default=True, help="auto, cpu, cuda or cuda:N.")
+@click.option("--views", type=click.IntRange(0, 360), default=8, show_default=True, help="Turntable frames.")
+@click.option("--view-size", type=click.IntRange(16, 1024), default=128, show_default=True,
+              help="Side in pixels of turntable frames, relit views and the material sphere.")
+@click.option("--env", "envs", multiple=True, type=click.Path(dir_okay=False, path_type=Path),
+              help="Extra relighting environment map (.hdr, .exr, .png, .npy); repeatable.")
+@click.option("--batch-size", type=click.IntRange(1, 1024), default=8, show_default=True)
+@click.option("--workers", type=click.IntRange(0, 64), default=2, show_default=True,
+              help="Threads reading and cropping images.")
+@click.option("--overwrite", is_flag=True, help="Redo objects whose folders are already complete.")
+@click.option("--contact-sheet", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Also write a contact sheet PNG (input, reconstruction, albedo, relit view per object).")
+def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks: Path | None, crop: str,
+             device: str, views: int, view_size: int, envs: tuple[Path, ...], batch_size: int, workers: int,
+             overwrite: bool, contact_sheet: Path | None) -> None:
+    """De-render INPUTS (image files, folders, prepared dataset folders) into --out."""
+    predictor = Predictor.from_checkpoint(checkpoint, device)
+    options = DerenderOptions(out=out, crop=crop, masks=masks, envs=envs, batch_size=batch_size,  # type: ignore[arg-type]
+                              workers=workers, overwrite=overwrite, export=ExportConfig(views, view_size))
+    summary = run_derender(list(inputs), predictor, options, say=lambda line: click.echo(line, err=True))
+    if contact_sheet is not None and (summary.done or summary.skipped):
+        click.echo(f"contact sheet: {write_contact_sheet(out, contact_sheet)}")
+    click.echo(summary.line())
+    click.echo(f"gallery: {summary.index}")
+    if summary.failures:
+        click.echo(f"{len(summary.failures)} input(s) failed: see {out / 'failures.csv'}", err=True)
+        sys.exit(1)

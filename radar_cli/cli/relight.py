@@ -1,0 +1,22 @@
+"""`radar relight`: re-render a de-rendered object under a new environment map from a new view."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from radar_cli.derender.relight import relight as run_relight
+
+
+@click.command("relight")
+@click.argument("object_dir", type=click.Path(exists=True, file_okay=False, path_type=Path))
+@click.option("--env", "env", required=True, type=click.Path(dir_okay=False, path_type=Path),
+              help="Environment map: .hdr, .exr, .png/.jpg or .npy (equirectangular, camera frame).")
+@click.option("--yaw", type=float, default=0.0, show_default=True, help="Spin about the object's axis (deg).")
+@click.option("--pitch", type=float, default=None, help="Camera elevation in degrees (default: predicted).")
+@click.option("--size", type=int, default=None, help="Image side in pixels (default: the input's).")
+@click.option("--out", required=True, type=click.Path(dir_okay=False, path_type=Path), help="Image to write.")
+def relight(object_dir: Path, env: Path, yaw: float, pitch: float | None, size: int | None, out: Path) -> None:
+    """Relight OBJECT_DIR (a folder written by `radar derender`) without the network."""
+    click.echo(f"wrote {run_relight(object_dir, env, out, yaw, pitch, size)}")

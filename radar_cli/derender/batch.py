@@ -1,0 +1,154 @@
+"""The `radar derender` driver: inputs -> crops -> network in batches -> per-object exports -> report.
+
+One bad input costs one line and one failures.csv row; the rest are processed. Finished object folders are
+skipped (a killed run resumes) and never overwritten without `overwrite`.
+"""
+
+from __future__ import annotations
+
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+from tqdm import tqdm
+
+from radar_cli.derender.environments import builtin_environments, env_name, load_environment
+from radar_cli.derender.export import ExportConfig, export_object, is_complete
+from radar_cli.derender.inputs import CropMode, Failure, InputItem, Prepared, collect_inputs, prepare
+from radar_cli.derender.predictor import Predictor
+from radar_cli.derender.report import write_report
+from radar_cli.errors import InputError, RadarError
+
+# errors of one object's export that must not stop the batch (decoding, writing, a degenerate prediction)
+ITEM_ERRORS = (RadarError, OSError, ValueError, RuntimeError)
+
+
+@dataclass(frozen=True)
+class DerenderOptions:
+    """How a batch is run (the CLI's options)."""
+
+    out: Path
+    crop: CropMode = "auto"
+    masks: Path | None = None
+    envs: tuple[Path, ...] = ()
+    batch_size: int = 8
+    workers: int = 2
+    overwrite: bool = False
+    export: ExportConfig = field(default_factory=ExportConfig)
+
+
+@dataclass
+class BatchSummary:
+    """What a run did."""
+
+    done: list[str] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+    failures: list[Failure] = field(default_factory=list)
+    seconds: float = 0.0
+    index: Path | None = None
+
+    def line(self) -> str:
+        rate = len(self.done) / self.seconds if self.seconds > 0 else 0.0
+        return (f"{len(self.done)} de-rendered, {len(self.skipped)} skipped (already done), "
+                f"{len(self.failures)} failed in {self.seconds:.1f} s ({rate:.2f} objects/s)")
+
+
+def environments(paths: tuple[Path, ...], height: int, width: int) -> dict[str, np.ndarray]:
+    """The built-in relighting environments plus the user's (named by file stem), at the model's size."""
+    envs = builtin_environments(height, width)
+    for path in paths:
+        name = env_name(path)
+        if name in envs:
+            raise InputError(f"{path}: environment name {name!r} is already used; rename the file")
+        envs[name] = load_environment(path, height, width)
+    return envs
+
+
+def _prepare_all(items: list[InputItem], size: int, crop: CropMode,
+                 workers: int) -> list[Prepared | Failure]:
+    """Read and crop a batch of inputs (threads: decoding and detection release the GIL)."""
+    def one(item: InputItem) -> Prepared | Failure:
+        try:
+            return prepare(item, size, crop)
+        except RadarError as e:
+            return Failure(str(item.image_path), str(e).removeprefix(f"{item.image_path}: "))
+
+    if workers <= 1:
+        return [one(item) for item in items]
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        return list(pool.map(one, items))
+
+
+def _pending(items: list[InputItem], out: Path, overwrite: bool, summary: BatchSummary,
+             say: Callable[[str], None]) -> list[InputItem]:
+    """The items still to do; finished folders are skipped unless `overwrite`."""
+    todo = []
+    for item in items:
+        if is_complete(out / item.name) and not overwrite:
+            summary.skipped.append(item.name)
+            say(f"{item.name}: skipped, {out / item.name} exists (use --overwrite to redo it)")
+        else:
+            todo.append(item)
+    return todo
+
+
+def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOptions,
+             say: Callable[[str], None] = tqdm.write) -> BatchSummary:
+    """De-render every input into options.out/<name>/ and write index.html, summary.csv and failures.csv.
+
+    Args:
+        inputs: image files, folders, prepared dataset folders.
+        predictor: the model.
+        options: output folder and settings.
+        say: where one-line messages (skips, failures) go.
+
+    Returns:
+        BatchSummary; the caller decides the exit code (non-zero if any failure).
+    """
+    start = time.perf_counter()
+    if options.batch_size < 1 or options.workers < 0:
+        raise InputError("--batch-size must be >= 1 and --workers >= 0")
+    render = predictor.setup.render
+    envs = environments(options.envs, render.env_height, render.env_width)
+    items, failures = collect_inputs(list(inputs), options.masks)
+    summary = BatchSummary(failures=list(failures))
+    for f in failures:
+        say(f.line())
+    options.out.mkdir(parents=True, exist_ok=True)
+    todo = _pending(items, options.out, options.overwrite, summary, say)
+    with tqdm(total=len(todo), desc="derender", unit="obj", disable=None) as bar:
+        for i in range(0, len(todo), options.batch_size):
+            chunk = todo[i : i + options.batch_size]
+            _run_batch(chunk, predictor, options, envs, summary, say)
+            bar.update(len(chunk))
+    summary.index = write_report(options.out, summary.failures)
+    summary.seconds = time.perf_counter() - start
+    return summary
+
+
+def _run_batch(chunk: list[InputItem], predictor: Predictor, options: DerenderOptions,
+               envs: dict[str, np.ndarray], summary: BatchSummary, say: Callable[[str], None]) -> None:
+    """Crop, predict and export one batch; failures are recorded item by item."""
+    prepared = _prepare_all(chunk, predictor.setup.image_size, options.crop, options.workers)
+    ok = []
+    for item, prep in zip(chunk, prepared):
+        if isinstance(prep, Failure):
+            summary.failures.append(prep)
+            say(prep.line())
+        else:
+            ok.append((item, prep))
+    if not ok:
+        return
+    dec = predictor.predict([prep.image for _, prep in ok])
+    for k, (item, prep) in enumerate(ok):
+        try:
+            export_object(options.out / item.name, item, prep, dec.select(k), predictor.setup,
+                          predictor.version, envs, options.export)
+            summary.done.append(item.name)
+        except ITEM_ERRORS as e:
+            failure = Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
+            summary.failures.append(failure)
+            say(failure.line())

@@ -1,0 +1,197 @@
+"""What `radar derender` reads: collect image files, folders and prepared datasets, and turn each photograph
+into the network's square input crop (locating the object in photos that are not square crops yet)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from radar_cli.dataset import IMAGE_FILE, MASK_FILE, is_dataset, safe_id
+from radar_cli.errors import InputError
+from radar_cli.fileio import read_image
+from radar_cli.masks.crop import CropBox, cut, mask_box, square_box
+
+IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".webp", ".tif", ".tiff")
+CropMode = Literal["auto", "none"]
+
+
+@dataclass(frozen=True)
+class InputItem:
+    """One photograph to de-render.
+
+    Attributes:
+        name: the object's folder name under RESULTS (unique within a run, [A-Za-z0-9._-]).
+        image_path: the photo.
+        mask_path: a known silhouette (prepared dataset or --masks), used to crop; None if unknown.
+    """
+
+    name: str
+    image_path: Path
+    mask_path: Path | None = None
+
+
+@dataclass(frozen=True)
+class Failure:
+    """An input that could not be de-rendered: the file or folder and a one-line problem."""
+
+    source: str
+    problem: str
+
+    def line(self) -> str:
+        return f"{self.source}: {self.problem}"
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """An input ready for the network.
+
+    Attributes:
+        image: S x S x 3 uint8 RGB crop (S = the model's image size).
+        crop: the square window of the original photo the crop shows (x0, y0, side in its pixels).
+        photo_size: (width, height) of the original photo after EXIF orientation.
+    """
+
+    image: np.ndarray
+    crop: CropBox
+    photo_size: tuple[int, int]
+
+
+def _is_image(path: Path) -> bool:
+    return path.suffix.lower() in IMAGE_SUFFIXES and not path.name.startswith(".")
+
+
+def _folder_items(folder: Path, masks: Path | None) -> list[tuple[str, Path, Path | None]]:
+    """(name, image, mask) for a prepared dataset (<split>/<id>/image.png) or every image under a folder."""
+    if is_dataset(folder):
+        found = sorted(folder.glob(f"*/*/{IMAGE_FILE}"))
+        return [(f"{p.parent.parent.name}_{p.parent.name}", p, _existing(p.parent / MASK_FILE)) for p in found]
+    images = sorted(p for p in folder.rglob("*") if p.is_file() and _is_image(p))
+    return [(p.stem, p, _mask_for(p, masks)) for p in images]
+
+
+def _existing(path: Path) -> Path | None:
+    return path if path.is_file() else None
+
+
+def _mask_for(image: Path, masks: Path | None) -> Path | None:
+    """A silhouette for `image` in the --masks folder: <stem>.png or <stem>/mask.png."""
+    if masks is None:
+        return None
+    return _existing(masks / f"{image.stem}.png") or _existing(masks / image.stem / MASK_FILE)
+
+
+def collect_inputs(paths: list[str | Path], masks: str | Path | None = None) -> tuple[list[InputItem],
+                                                                                      list[Failure]]:
+    """Expand the command line's inputs into photos to de-render.
+
+    Files must have an image suffix; folders are searched recursively for images (other files, such as a
+    SOURCES.tsv, are ignored); a folder with no image is a failure. Names are the file stems, made safe and
+    unique.
+
+    Args:
+        paths: files and folders, in order.
+        masks: optional folder of known silhouettes (<stem>.png or <stem>/mask.png).
+
+    Returns:
+        (items, failures), items in input order without duplicates.
+    """
+    masks_dir = Path(masks) if masks is not None else None
+    if masks_dir is not None and not masks_dir.is_dir():
+        raise InputError(f"{masks_dir}: --masks folder does not exist")
+    found: list[tuple[str, Path, Path | None]] = []
+    failures: list[Failure] = []
+    for raw in paths:
+        path = Path(raw)
+        if path.is_dir():
+            items = _folder_items(path, masks_dir)
+            if not items:
+                failures.append(Failure(str(path), f"folder holds no images ({', '.join(IMAGE_SUFFIXES)})"))
+            found.extend(items)
+        elif path.is_file():
+            if _is_image(path):
+                found.append((path.stem, path, _mask_for(path, masks_dir)))
+            else:
+                failures.append(Failure(str(path), f"not an image file (expected {', '.join(IMAGE_SUFFIXES)})"))
+        else:
+            failures.append(Failure(str(path), "no such file or folder"))
+    return _unique(found, failures), failures
+
+
+def _unique(found: list[tuple[str, Path, Path | None]], failures: list[Failure]) -> list[InputItem]:
+    """InputItems with safe, unique names; the same file given twice is de-rendered once."""
+    items, names, seen = [], set(), set()
+    for stem, image, mask in found:
+        key = image.resolve()
+        if key in seen:
+            continue
+        seen.add(key)
+        try:
+            base = safe_id(stem)
+        except InputError as e:
+            failures.append(Failure(str(image), str(e)))
+            continue
+        name, k = base, 2
+        while name.lower() in names:
+            name, k = f"{base}-{k}", k + 1
+        names.add(name.lower())
+        items.append(InputItem(name, image, mask))
+    return items
+
+
+def locate(photo: np.ndarray, mask: np.ndarray | None) -> CropBox:
+    """The square crop around the object: from a known silhouette, else from radar masks' detector.
+
+    Args:
+        photo: H x W x 3 uint8.
+        mask: H x W bool known silhouette, or None.
+    """
+    if mask is not None:
+        box = mask_box(mask)
+        if box is None:
+            raise InputError("the given mask is empty")
+        return square_box(box)
+    from radar_cli.masks.detect import detect
+
+    found = detect(photo)
+    if not found:
+        raise InputError("no object stands out from the backdrop; crop it square or use --crop none")
+    return square_box(found[0].box)
+
+
+def whole_photo(photo: np.ndarray) -> CropBox:
+    """The smallest square window centred on the photo that contains all of it (sides padded)."""
+    h, w = photo.shape[:2]
+    side = max(h, w)
+    return CropBox((w - side) // 2, (h - side) // 2, side)
+
+
+def prepare(item: InputItem, size: int, crop: CropMode = "auto") -> Prepared:
+    """Read a photo and cut the network's input: square photos are used whole, others are cropped around the
+    object (`auto`) or padded to a square (`none`).
+
+    Args:
+        item: the input.
+        size: S, the model's image side.
+        crop: `auto` or `none`.
+
+    Returns:
+        Prepared; InputError names the file on any problem.
+    """
+    photo = read_image(item.image_path, "RGB")
+    h, w = photo.shape[:2]
+    mask = None
+    if item.mask_path is not None:
+        mask = read_image(item.mask_path, "L") > 127
+        if mask.shape != (h, w):
+            raise InputError(f"{item.mask_path}: mask size {mask.shape} does not match the photo's {(h, w)}")
+    if crop == "auto" and (h != w or mask is not None):
+        try:
+            box = locate(photo, mask)
+        except InputError as e:
+            raise InputError(f"{item.image_path}: {e}") from None
+    else:
+        box = whole_photo(photo)
+    return Prepared(np.ascontiguousarray(cut(photo, box, size)), box, (w, h))

@@ -1,0 +1,56 @@
+"""Textured meshes of one object: mesh.glb (PBR material: 360 deg albedo, roughness from the shininess) and
+mesh.obj + .mtl + texture, via trimesh, in the canonical object frame (axis = +y, the seen side facing -z)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import trimesh
+from PIL import Image
+
+from radar_cli.derender.maps import chw_image
+from radar_cli.derender.state import ObjectState, roughness_from_shininess
+from radar_cli.fileio import write_bytes
+from radar_cli.render.lighting import tone_map
+from radar_cli.results import MESH_GLB_FILE, MESH_OBJ_FILE
+from radar_cli.sor.mesh import triangulate
+
+MAX_SPECULAR_FACTOR = 1.0  # MTL Ks lies in [0, 1]; rho (0..2) is halved and clipped for it
+
+
+def build_mesh(state: ObjectState, n_cols: int) -> trimesh.Trimesh:
+    """A trimesh of the SoR with uv texture coordinates and the albedo as texture.
+
+    Args:
+        state: the object.
+        n_cols: K, angles around the axis.
+    """
+    sor = triangulate(state.radius, state.height, n_cols, closed_bottom=True, camera=state.camera)
+    texture = Image.fromarray(chw_image(tone_map(state.albedo, state.render.gamma)))
+    material = trimesh.visual.material.PBRMaterial(
+        name="albedo", baseColorTexture=texture, metallicFactor=0.0,
+        roughnessFactor=roughness_from_shininess(float(state.alpha[0])), doubleSided=True)
+    visual = trimesh.visual.TextureVisuals(uv=sor.uv.numpy(), material=material)
+    return trimesh.Trimesh(sor.vertices.numpy().astype(np.float64), sor.faces.numpy(), visual=visual,
+                           process=False)
+
+
+def write_meshes(folder: Path, state: ObjectState, n_cols: int) -> None:
+    """mesh.glb, and mesh.obj with its material.mtl and texture PNG, written atomically."""
+    mesh = build_mesh(state, n_cols)
+    write_bytes(folder / MESH_GLB_FILE, mesh.export(file_type="glb"))
+    obj_mesh = mesh.copy()
+    # OBJ/MTL is Phong: white Kd so viewers show the texture as is, Ns = shininess, Ks from the specular albedo
+    spec = int(round(255 * min(float(state.rho[0]) / 2.0, MAX_SPECULAR_FACTOR)))
+    obj_mesh.visual.material = trimesh.visual.material.SimpleMaterial(
+        name="albedo", image=mesh.visual.material.baseColorTexture, diffuse=(255, 255, 255, 255),
+        ambient=(255, 255, 255, 255), specular=(spec, spec, spec, 255), glossiness=float(state.alpha[0]))
+    text, files = trimesh.exchange.obj.export_obj(obj_mesh, include_texture=True, return_texture=True,
+                                                  mtl_name="mesh.mtl")
+    for name, data in files.items():
+        if Path(name).name != name:  # trimesh names these; never write outside the folder
+            raise OSError(f"unexpected texture file name from the OBJ exporter: {name!r}")
+        write_bytes(folder / name, data)
+    write_bytes(folder / MESH_OBJ_FILE, text.encode("utf-8"))
+

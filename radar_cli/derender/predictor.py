@@ -1,0 +1,114 @@
+"""Inference state for de-rendering: the model, its configuration and device, and batched prediction under
+torch.no_grad. The only place that knows how a checkpoint becomes a model."""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import torch
+
+from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig
+from radar_cli.errors import CheckpointError, InputError
+from radar_cli.model.outputs import Decomposition
+
+ASSETS = Path(__file__).resolve().parents[1] / "assets"
+
+
+def bundled_checkpoint() -> Path:
+    """The default model shipped inside the package (the one .safetensors file in radar_cli/assets)."""
+    found = sorted(ASSETS.glob("*.safetensors")) if ASSETS.is_dir() else []
+    if not found:
+        raise CheckpointError(f"{ASSETS}: no bundled model (*.safetensors) found; pass --checkpoint PATH")
+    return found[0]
+
+
+def resolve_device(name: str) -> torch.device:
+    """`auto` picks CUDA when available; `cpu`, `cuda`, `cuda:N` are taken as given (checked)."""
+    if name == "auto":
+        return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+    try:
+        device = torch.device(name)
+    except RuntimeError:
+        raise InputError(f"unknown device {name!r} (use auto, cpu or cuda)") from None
+    if device.type == "cuda" and not torch.cuda.is_available():
+        raise InputError(f"device {name!r} requested but CUDA is not available")
+    return device
+
+
+@dataclass(frozen=True)
+class ModelSetup:
+    """The parts of a model's configuration that de-rendering and export need."""
+
+    render: RenderConfig
+    camera: CameraConfig
+    geometry: GeometryConfig
+
+    @property
+    def image_size(self) -> int:
+        return self.render.image_size
+
+
+class Predictor:
+    """Batches images through a de-rendering model on one device.
+
+    Args:
+        model: any callable image B x 3 x S x S in [0, 1] -> Decomposition (a RadarModel in practice).
+        setup: the model's render, camera and geometry configuration.
+        version: a label recorded in every material.json (checkpoint name and hash).
+        device: where the model runs.
+    """
+
+    def __init__(self, model: Callable[[torch.Tensor], Decomposition], setup: ModelSetup, version: str,
+                 device: torch.device | str = "cpu"):
+        self.model = model
+        self.setup = setup
+        self.version = version
+        self.device = torch.device(device)
+
+    @classmethod
+    def from_checkpoint(cls, path: str | Path | None = None, device: str = "auto") -> "Predictor":
+        """Load a checkpoint (default: the bundled model); CheckpointError if it is missing or does not fit."""
+        path = Path(path) if path is not None else bundled_checkpoint()
+        if not path.is_file():
+            raise CheckpointError(f"{path}: no such checkpoint")
+        dev = resolve_device(device)
+        try:
+            from radar_cli.train.checkpoint import load_model
+        except ImportError as e:
+            raise CheckpointError(f"{path}: this build cannot load checkpoints ({e})") from None
+        model, _ = load_model(path, dev)
+        model.eval()
+        cfg = model.config
+        setup = ModelSetup(cfg.render, cfg.camera, cfg.geometry)
+        return cls(model, setup, f"{path.name}#{_short_hash(path)}", dev)
+
+    @torch.no_grad()
+    def predict(self, images: list[np.ndarray]) -> Decomposition:
+        """De-render a batch of crops.
+
+        Args:
+            images: S x S x 3 uint8 RGB crops, S = setup.image_size.
+
+        Returns:
+            Decomposition of the batch, on the CPU, detached.
+        """
+        size = self.setup.image_size
+        for im in images:
+            if im.shape != (size, size, 3) or im.dtype != np.uint8:
+                raise InputError(f"expected {size} x {size} x 3 uint8 crops, got {im.shape} {im.dtype}")
+        batch = torch.from_numpy(np.stack(images)).permute(0, 3, 1, 2)  # B x 3 x S x S uint8
+        batch = batch.to(self.device, torch.float32) / 255.0
+        return self.model(batch).detach().to("cpu")
+
+
+def _short_hash(path: Path) -> str:
+    """First 12 hex digits of the file's SHA-256."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()[:12]

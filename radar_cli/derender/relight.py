@@ -1,0 +1,42 @@
+"""`radar relight`: re-render a de-rendered object folder under a new environment map from a new view, without
+the network (shape, pose, material from material.json, albedo from albedo.png, lighting from the file given)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import torch
+
+from radar_cli.derender.environments import load_environment
+from radar_cli.derender.renders import render_object
+from radar_cli.derender.state import read_record, read_state
+from radar_cli.errors import InputError
+from radar_cli.fileio import write_image
+
+MAX_SIZE = 4096
+
+
+def relight(folder: str | Path, env_path: str | Path, out: str | Path, yaw_deg: float = 0.0,
+            pitch_deg: float | None = None, size: int | None = None) -> Path:
+    """Render one object under another environment map.
+
+    Args:
+        folder: RESULTS/<object> written by `radar derender`.
+        env_path: .hdr, .exr, .png/.jpg or .npy environment map (camera frame, see radar_cli.derender.environments).
+        out: the image to write (.png, .jpg, .webp).
+        yaw_deg: spin about the object's axis.
+        pitch_deg: camera elevation in degrees (default: the predicted pitch).
+        size: image side in pixels (default: the network's input size recorded in material.json).
+
+    Returns:
+        The path written.
+    """
+    state = read_state(folder)
+    size = size or int(read_record(folder).get("image_size", 256))
+    if not 8 <= size <= MAX_SIZE:
+        raise InputError(f"--size must lie in [8, {MAX_SIZE}], got {size}")
+    env = load_environment(env_path, state.env.shape[1], state.env.shape[2])
+    image = render_object(state, size, yaw_deg, pitch_deg, env=torch.from_numpy(env)[None])
+    write_image(out, image)
+    return Path(out)
+

@@ -1,0 +1,160 @@
+"""Image-space renders of one object: silhouettes, reconstruction, albedo and normals in the input view, the
+material on a sphere, a turntable (GIF + PNG strip) and relit views."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+from pathlib import Path
+
+import numpy as np
+import torch
+from PIL import Image
+
+from radar_cli.config import CameraConfig
+from radar_cli.derender.maps import chw_image
+from radar_cli.derender.state import ObjectState
+from radar_cli.fileio import atomic_path, to_uint8, write_image
+from radar_cli.render.lighting import compose, tone_map
+from radar_cli.render.raycast import Hits, cast_rays
+from radar_cli.render.scene import Shading, render_front, rotate_full_map, shade
+from radar_cli.render.texture import render_texture
+from radar_cli.sor.surface import FULL_SPAN
+from radar_cli.results import (ALBEDO_RENDERED_FILE, MASK_FILE, MASK_FRONT_FILE, MATERIAL_SPHERE_FILE,
+                               NORMAL_RENDERED_FILE, RECON_FILE, RELIT_PREFIX, TURNTABLE_GIF_FILE,
+                               TURNTABLE_STRIP_FILE)
+
+SPHERE_ROWS = 64
+SPHERE_RADIUS = 0.8  # fraction of r_max
+SPHERE_MIN_RADIUS = 0.02  # the poles are kept open a hair so the profile stays a valid SoR
+TURNTABLE_FRAME_MS = 120
+
+
+class ViewRenderer:
+    """Draws one object from one camera pose, many times.
+
+    The solid is symmetric about its axis, so spinning it (yaw) only moves the albedo over a fixed surface: the
+    rays are cast once, and the lighting is shaded once per environment. Each image equals
+    radar_cli.render.scene.render_view with the same arguments.
+
+    Args:
+        state: the object.
+        size: image side in pixels.
+        pitch_deg: replaces the predicted pitch if given.
+        hits: the ray-casting result for this shape, pose and size, if already known.
+    """
+
+    def __init__(self, state: ObjectState, size: int, pitch_deg: float | None = None, hits: Hits | None = None):
+        self.state = state
+        self.pose = state.pose.clone()
+        if pitch_deg is not None:
+            self.pose[:, 0] = pitch_deg
+        if hits is None:
+            with torch.no_grad():
+                hits = cast_rays(state.radius, state.height, self.pose, size, state.camera,
+                                 state.render.sil_sigma_px)
+        self.hits = hits
+
+    @torch.no_grad()
+    def shading(self, env: torch.Tensor | None = None) -> Shading:
+        """The 360 deg lighting factors under `env` (1 x He x We; default: the predicted one)."""
+        s = self.state
+        env = s.env if env is None else env
+        return shade(s.radius, s.height, self.pose, s.albedo, env, s.alpha, s.rho, s.render, s.camera,
+                     span=FULL_SPAN)
+
+    @torch.no_grad()
+    def draw(self, shading: Shading, yaw_deg: float = 0.0, background: float = 1.0) -> np.ndarray:
+        """The shaded object spun by `yaw_deg`: size x size x 3 uint8 over a grey level `background`."""
+        s = self.state
+        albedo = rotate_full_map(s.albedo, yaw_deg)
+        texture = compose(albedo, shading.diffuse, shading.specular, s.rho, s.render.gamma)
+        image, _ = render_texture(self.hits, texture, front_only=False, inside_dim=s.render.inside_dim,
+                                  background=background)
+        return chw_image(image)
+
+
+def render_object(state: ObjectState, size: int, yaw_deg: float = 0.0, pitch_deg: float | None = None,
+                  env: torch.Tensor | None = None, background: float = 1.0) -> np.ndarray:
+    """The whole shaded object from a new view (spun by yaw, optionally another pitch) and lighting.
+
+    Returns:
+        size x size x 3 uint8 over a grey level `background`.
+    """
+    view = ViewRenderer(state, size, pitch_deg)
+    return view.draw(view.shading(env), yaw_deg, background)
+
+
+@torch.no_grad()
+def write_input_view(folder: Path, state: ObjectState, size: int) -> None:
+    """mask.png, mask_front.png, albedo_rendered.png, normal_rendered.png and recon.png at the input's size."""
+    view = ViewRenderer(state, size)
+    hits = view.hits
+    coverage = torch.where(hits.mask, torch.ones_like(hits.sil), hits.sil)  # 1 x S x S
+    write_image(folder / MASK_FILE, to_uint8(coverage[0].numpy()))
+    _, front = render_front(hits, torch.ones_like(state.albedo[:, :1, :, : state.albedo.shape[-1] // 3]))
+    write_image(folder / MASK_FRONT_FILE, to_uint8(front[0, 0].numpy()))
+    albedo, _ = render_texture(hits, tone_map(state.albedo, state.render.gamma), inside_dim=1.0, background=1.0)
+    write_image(folder / ALBEDO_RENDERED_FILE, chw_image(albedo))
+    normals = torch.where(hits.mask[..., None], (hits.normal + 1) / 2, torch.zeros_like(hits.normal))
+    write_image(folder / NORMAL_RENDERED_FILE, to_uint8(normals[0].numpy()))
+    write_image(folder / RECON_FILE, view.draw(view.shading()))
+
+
+def sphere_profile() -> tuple[torch.Tensor, torch.Tensor]:
+    """A sphere as a SoR: radius column sqrt(1 - y^2) (1 x L) and half-height (1), fractions of r_max."""
+    y = torch.linspace(1.0, -1.0, SPHERE_ROWS)
+    radius = (SPHERE_RADIUS * torch.sqrt(1 - y**2)).clamp_min(SPHERE_MIN_RADIUS)[None]
+    return radius, torch.tensor([SPHERE_RADIUS])
+
+
+@functools.lru_cache(maxsize=4)
+def _sphere_hits(size: int, camera: CameraConfig, sigma_px: float) -> Hits:
+    """The sphere's ray casting is the same for every object: done once per size."""
+    radius, height = sphere_profile()
+    with torch.no_grad():
+        return cast_rays(radius, height, torch.zeros(1, 4), size, camera, sigma_px)
+
+
+def material_sphere(state: ObjectState, size: int) -> np.ndarray:
+    """The recovered material and lighting on a sphere with the object's mean albedo, seen straight on."""
+    radius, height = sphere_profile()
+    mean = state.albedo.mean(dim=(2, 3), keepdim=True)  # 1 x 3 x 1 x 1
+    sphere = dataclasses.replace(state, radius=radius, height=height, pose=torch.zeros(1, 4),
+                                 albedo=mean.expand(-1, -1, 16, 48).contiguous())
+    view = ViewRenderer(sphere, size, hits=_sphere_hits(size, state.camera, state.render.sil_sigma_px))
+    return view.draw(view.shading())
+
+
+def write_turntable(folder: Path, view: ViewRenderer, frames: int) -> None:
+    """turntable.gif (looping) and turntable.png (the frames side by side): `frames` equal yaw steps."""
+    shading = view.shading()
+    views = [view.draw(shading, yaw_deg=360.0 * k / frames) for k in range(frames)]
+    write_image(folder / TURNTABLE_STRIP_FILE, np.concatenate(views, axis=1))
+    images = [Image.fromarray(v) for v in views]
+    with atomic_path(folder / TURNTABLE_GIF_FILE) as tmp:
+        images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], duration=TURNTABLE_FRAME_MS,
+                       loop=0)
+
+
+def relit_file(name: str) -> str:
+    """File name of the view relit under environment `name`."""
+    return f"{RELIT_PREFIX}{name}.png"
+
+
+def write_relit(folder: Path, view: ViewRenderer, envs: dict[str, np.ndarray]) -> None:
+    """relit_<name>.png for every environment (He x We maps, camera frame), from the input's view."""
+    for name, env in envs.items():
+        shading = view.shading(torch.from_numpy(np.asarray(env, np.float32))[None])
+        write_image(folder / relit_file(name), view.draw(shading))
+
+
+def write_renders(folder: Path, state: ObjectState, input_size: int, view_size: int, frames: int,
+                  envs: dict[str, np.ndarray]) -> None:
+    """Every render of one object."""
+    write_input_view(folder, state, input_size)
+    write_image(folder / MATERIAL_SPHERE_FILE, material_sphere(state, view_size))
+    view = ViewRenderer(state, view_size)
+    if frames > 0:
+        write_turntable(folder, view, frames)
+    write_relit(folder, view, envs)
