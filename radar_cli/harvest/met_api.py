@@ -118,6 +118,9 @@ class MetApi:
                 break
             ids += page
             offset += self.page_size
+        if len(ids) < min(total, self.result_cap):
+            self.warn(f"search {params}: got {len(ids)} of {total} results; the API may cap results lower "
+                      f"than --result-cap {self.result_cap}")
         return ids
 
     def _split(self, params: dict[str, Any]) -> list[dict[str, Any]]:

@@ -47,3 +47,14 @@ def test_unsplittable_part_warns_and_keeps_the_cap(met_server, harvest_config):
     warnings: list[str] = []
     ids = api_for(met_server, harvest_config().api_client, warnings).search("vase", department=6)
     assert len(ids) == 5 and len(warnings) == 1 and "cannot split further" in warnings[0]
+
+
+def test_a_lower_cap_than_configured_is_reported(met_server, harvest_config):
+    met_server.cap = 5
+    for i in range(1, 9):
+        met_server.add(i)
+    warnings: list[str] = []
+    api = MetApi(HttpClient(harvest_config().api_client), met_server.api_url, page_size=2, result_cap=100,
+                 warn=warnings.append)
+    assert len(api.search("vase")) == 5
+    assert len(warnings) == 1 and "got 5 of 8 results" in warnings[0]
