@@ -41,7 +41,9 @@ class ClientConfig:
     backoff_base: float = 1.0
     """Full-jitter backoff: sleep uniform(0, min(backoff_cap, backoff_base * 2**attempt)) seconds."""
     backoff_cap: float = 60.0
-    """Upper bound of one backoff sleep (and of an honoured Retry-After)."""
+    """Upper bound of one backoff sleep."""
+    max_retry_after: float = 600.0
+    """Upper bound of an honoured Retry-After (a longer one is waited this long, then retried)."""
     block_wait: float = 60.0
     """Seconds to wait out a bot-protection block (plus up to half of it again as jitter)."""
     block_retries: int = 3
@@ -175,8 +177,8 @@ class HttpClient:
                     attempt += 1
                     if attempt > self.config.retries:
                         raise FetchError(f"{url}: {e} (gave up after {attempt} attempts)") from None
-                    wait = e.wait if e.wait is not None else self._backoff(attempt)
-                self.sleep(min(wait, max(self.config.backoff_cap, self.config.block_wait * 1.5)))
+                    wait = min(e.wait, self.config.max_retry_after) if e.wait is not None else self._backoff(attempt)
+                self.sleep(wait)
 
     def _backoff(self, attempt: int) -> float:
         """Full-jitter exponential backoff for the given (1-based) retry."""

@@ -143,6 +143,11 @@ class Harvester:
         if cfg.limit is not None:
             ids = ids[: cfg.limit]
         self.summary.found = len(ids)
+        asked = cfg.query if cfg.ids_file is None else f"ids from {cfg.ids_file}"
+        previous = self.catalog.get_meta("query")
+        if previous is not None and previous != asked:
+            self.log(f"note: {cfg.out} was harvested for {previous!r} before; adding {asked!r} to the same catalog")
+        self.catalog.set_meta("query", asked)
         self.catalog.add_searched(ids)
         if cfg.since:
             changed = self.api.changed_since(cfg.since, cfg.department)

@@ -157,8 +157,8 @@ def _handler(met: FakeMet) -> type[BaseHTTPRequestHandler]:
         def inject(self, fault: str) -> None:
             if fault in ("500", "503"):
                 self.send(int(fault), b'{"message":"Internal Server Error"}')
-            elif fault == "429":
-                self.send(429, b"Too Many Requests", "text/plain", {"Retry-After": "0"})
+            elif fault.startswith("429"):  # "429" or "429:<Retry-After seconds>"
+                self.send(429, b"Too Many Requests", "text/plain", {"Retry-After": (fault + ":0").split(":")[1]})
             elif fault == "html403":
                 self.send(403, met.block_page, "text/html")
             elif fault == "html200":

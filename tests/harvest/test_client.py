@@ -60,6 +60,14 @@ def test_429_honours_retry_after(met_server, fast):
     assert sleeps == [0.0]  # the server said Retry-After: 0
 
 
+def test_long_retry_after_is_honoured_not_shortened(met_server, fast):
+    met_server.add(7)
+    met_server.fault(OBJ, "429:120")
+    client, sleeps = client_with_sleeps(fast)  # backoff_cap is 0.01 s: Retry-After is not a backoff
+    assert client.get(met_server.api_url + "v1/objects/7", expect_json=True).status == 200
+    assert sleeps == [120.0]
+
+
 @pytest.mark.parametrize("fault", ["html403", "html200"])
 def test_block_page_is_waited_out(met_server, fast, fault):
     met_server.add(7)
