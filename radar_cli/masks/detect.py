@@ -137,10 +137,10 @@ def backdrop_distance(image: np.ndarray, band: np.ndarray) -> np.ndarray:
     ratio = (smooth * model).sum(2) / np.maximum((model * model).sum(2), 1.0)
     chroma = np.sqrt((((smooth - ratio[..., None] * model) / noise) ** 2).sum(axis=2))
     grey = smooth.mean(axis=2)
-    texture = np.hypot(cv2.Sobel(grey, cv2.CV_32F, 1, 0), cv2.Sobel(grey, cv2.CV_32F, 0, 1)) / (4 * noise.mean())
-    texture = cv2.GaussianBlur(texture, (0, 0), 2.0)
+    # band-pass detail: object outlines and surface texture have it, soft shadow edges and light pools do not
+    texture = cv2.GaussianBlur(np.abs(grey - cv2.GaussianBlur(grey, (0, 0), 1.5)), (0, 0), 2.0) / noise.mean()
     lighting = (ratio > LIGHT_RANGE[0]) & (ratio < LIGHT_RANGE[1])
-    return np.where(lighting, np.minimum(dist, 1.5 * chroma + 2.0 * texture), dist)
+    return np.where(lighting, np.minimum(dist, 1.5 * chroma + 3.0 * texture), dist)
 
 
 def edge_map(image: np.ndarray) -> np.ndarray:
