@@ -24,7 +24,6 @@ from PIL import Image
 from radar_cli.harvest.client import ClientConfig
 from radar_cli.harvest.harvester import HarvestConfig
 
-MET_DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "met_api"
 TEMPLATES = {  # recorded responses: two public-domain objects with images, one not public domain
     "pd_scroll": "objects_45734_quail_and_millet_2020.json",
     "pd_cover": "objects_47533_porcelain_cover_2021.json",
@@ -42,18 +41,6 @@ def jpeg(seed: int, size: int = 24) -> bytes:
     buf = io.BytesIO()
     im.save(buf, format="JPEG", quality=90)
     return buf.getvalue()
-
-
-_BOMB: list[bytes] = []
-
-
-def bomb_png() -> bytes:
-    """A tiny PNG that decodes to 144 million pixels (a decompression bomb)."""
-    if not _BOMB:
-        buf = io.BytesIO()
-        Image.new("1", (12_000, 12_000)).save(buf, format="PNG")
-        _BOMB.append(buf.getvalue())
-    return _BOMB[0]
 
 
 @dataclass
@@ -119,104 +106,104 @@ class FakeMet:
         return lo <= record["objectBeginDate"] <= hi
 
 
-def _handler(met: FakeMet) -> type[BaseHTTPRequestHandler]:
-    class Handler(BaseHTTPRequestHandler):
-        protocol_version = "HTTP/1.1"
-        disable_nagle_algorithm = True  # headers and body go out as separate writes: avoid 40 ms ACK stalls
+class MetHandler(BaseHTTPRequestHandler):
+    """Serves one FakeMet (set as the `met` class attribute by a subclass)."""
 
-        def log_message(self, *args: Any) -> None:  # keep pytest output quiet
+    met: FakeMet
+    protocol_version = "HTTP/1.1"
+    disable_nagle_algorithm = True  # headers and body go out as separate writes: avoid 40 ms ACK stalls
+
+    def log_message(self, *args: Any) -> None:  # keep pytest output quiet
+        pass
+
+    def send(self, status: int, body: bytes, ctype: str = "application/json",
+             headers: dict[str, str] | None = None, declared: int | None = None) -> None:
+        self.send_response(status)
+        self.send_header("Content-Type", ctype)
+        self.send_header("Content-Length", str(len(body) if declared is None else declared))
+        for k, v in (headers or {}).items():
+            self.send_header(k, v)
+        self.end_headers()
+        self.wfile.write(body)
+
+    def do_GET(self) -> None:  # noqa: N802 (http.server's name)
+        url = urlparse(self.path)
+        with self.met.lock:
+            self.met.log.append(url.path)
+            self.met.agents.add(self.headers.get("User-Agent", ""))
+            queue = self.met.faults.get(url.path)
+            fault = queue.pop(0) if queue else ""
+        if self.met.delay:
+            time.sleep(self.met.delay)
+        try:
+            if fault:
+                self.inject(fault)
+            else:
+                self.route(url.path, {k: v[0] for k, v in parse_qs(url.query).items()})
+        except (BrokenPipeError, ConnectionResetError):
             pass
 
-        def send(self, status: int, body: bytes, ctype: str = "application/json",
-                 headers: dict[str, str] | None = None, declared: int | None = None) -> None:
-            self.send_response(status)
-            self.send_header("Content-Type", ctype)
-            self.send_header("Content-Length", str(len(body) if declared is None else declared))
-            for k, v in (headers or {}).items():
-                self.send_header(k, v)
+    def inject(self, fault: str) -> None:
+        if fault in ("500", "503"):
+            self.send(int(fault), b'{"message":"Internal Server Error"}')
+        elif fault.startswith("429"):  # "429" or "429:<Retry-After seconds>"
+            self.send(429, b"Too Many Requests", "text/plain", {"Retry-After": (fault + ":0").split(":")[1]})
+        elif fault == "html403":
+            self.send(403, self.met.block_page, "text/html")
+        elif fault == "html200":
+            self.send(200, self.met.block_page, "text/html")
+        elif fault == "malformed":
+            self.send(200, b'{"objectID": 1, "title": "unterminated')
+        elif fault == "truncated":
+            self.send(200, b'{"total": 3, "objec', declared=400)
+            self.close_connection = True
+        elif fault == "slow":  # a body that trickles in for longer than the client's per-attempt timeout
+            self.send_response(200)
+            self.send_header("Content-Type", "application/json")
+            self.send_header("Content-Length", "400")
             self.end_headers()
-            self.wfile.write(body)
+            for _ in range(40):
+                self.wfile.write(b" ")
+                self.wfile.flush()
+                time.sleep(0.05)
+            self.close_connection = True
+        else:
+            raise AssertionError(f"unknown fault {fault}")
 
-        def do_GET(self) -> None:  # noqa: N802 (http.server's name)
-            url = urlparse(self.path)
-            with met.lock:
-                met.log.append(url.path)
-                met.agents.add(self.headers.get("User-Agent", ""))
-                queue = met.faults.get(url.path)
-                fault = queue.pop(0) if queue else ""
-            if met.delay:
-                time.sleep(met.delay)
-            try:
-                if fault:
-                    self.inject(fault)
-                else:
-                    self.route(url.path, {k: v[0] for k, v in parse_qs(url.query).items()})
-            except (BrokenPipeError, ConnectionResetError):
-                pass
+    def route(self, path: str, query: dict[str, str]) -> None:
+        if path == "/api/v1.1/search":
+            self.send(200, json.dumps(self.met.search(query)).encode())
+        elif path == "/api/v1/departments":
+            self.send(200, json.dumps({"departments": self.met.departments}).encode())
+        elif path == "/api/v1/objects":
+            since = query.get("metadataDate", "")
+            ids = sorted(i for i, r in self.met.objects.items() if r["metadataDate"][:10] >= since)
+            self.send(200, json.dumps({"total": len(ids), "objectIDs": ids or None}).encode())
+        elif path.startswith("/api/v1/objects/"):
+            self.object(path.rsplit("/", 1)[1])
+        elif path.startswith("/images/"):
+            self.image(path.rsplit("/", 1)[1].split(".")[0].replace("-small", ""))
+        else:
+            self.send(404, b"<html>Not found</html>", "text/html")
 
-        def inject(self, fault: str) -> None:
-            if fault in ("500", "503"):
-                self.send(int(fault), b'{"message":"Internal Server Error"}')
-            elif fault.startswith("429"):  # "429" or "429:<Retry-After seconds>"
-                self.send(429, b"Too Many Requests", "text/plain", {"Retry-After": (fault + ":0").split(":")[1]})
-            elif fault == "html403":
-                self.send(403, met.block_page, "text/html")
-            elif fault == "html200":
-                self.send(200, met.block_page, "text/html")
-            elif fault == "malformed":
-                self.send(200, b'{"objectID": 1, "title": "unterminated')
-            elif fault == "truncated":
-                self.send(200, b'{"total": 3, "objec', declared=400)
-                self.close_connection = True
-            elif fault == "slow":  # a body that trickles in for longer than the client's per-attempt timeout
-                self.send_response(200)
-                self.send_header("Content-Type", "application/json")
-                self.send_header("Content-Length", "400")
-                self.end_headers()
-                for _ in range(40):
-                    self.wfile.write(b" ")
-                    self.wfile.flush()
-                    time.sleep(0.05)
-                self.close_connection = True
-            else:
-                raise AssertionError(f"unknown fault {fault}")
+    def object(self, tail: str) -> None:
+        if not tail.isdigit():
+            self.send(400, b'{"message":"could not parse objectID"}')
+        elif int(tail) in self.met.withdrawn or int(tail) not in self.met.objects:
+            self.send(404, b'{"message":"ObjectID not found"}')
+        else:
+            self.send(200, self.met.record_body(int(tail)))
 
-        def route(self, path: str, query: dict[str, str]) -> None:
-            if path == "/api/v1.1/search":
-                self.send(200, json.dumps(met.search(query)).encode())
-            elif path == "/api/v1/departments":
-                self.send(200, json.dumps({"departments": met.departments}).encode())
-            elif path == "/api/v1/objects":
-                since = query.get("metadataDate", "")
-                ids = sorted(i for i, r in met.objects.items() if r["metadataDate"][:10] >= since)
-                self.send(200, json.dumps({"total": len(ids), "objectIDs": ids or None}).encode())
-            elif path.startswith("/api/v1/objects/"):
-                self.object(path.rsplit("/", 1)[1])
-            elif path.startswith("/images/"):
-                self.image(path.rsplit("/", 1)[1].split(".")[0].replace("-small", ""))
-            else:
-                self.send(404, b"<html>Not found</html>", "text/html")
-
-        def object(self, tail: str) -> None:
-            if not tail.isdigit():
-                self.send(400, b'{"message":"could not parse objectID"}')
-            elif int(tail) in met.withdrawn or int(tail) not in met.objects:
-                self.send(404, b'{"message":"ObjectID not found"}')
-            else:
-                self.send(200, met.record_body(int(tail)))
-
-        def image(self, tail: str) -> None:
-            body = met.images.get(int(tail)) if tail.isdigit() else None
-            if body is None:
-                self.send(404, b"<html>Not found</html>", "text/html")
-                return
-            etag = '"%s"' % hashlib.sha256(body).hexdigest()[:16]
-            if self.headers.get("If-None-Match") == etag:
-                self.send(304, b"", "image/jpeg", {"ETag": etag})
-            else:
-                self.send(200, body, "image/jpeg", {"ETag": etag})
-
-    return Handler
+    def image(self, tail: str) -> None:
+        body = self.met.images.get(int(tail)) if tail.isdigit() else None
+        if body is None:
+            self.send(404, b"<html>Not found</html>", "text/html")
+            return
+        etag = '"%s"' % hashlib.sha256(body).hexdigest()[:16]
+        if self.headers.get("If-None-Match") == etag:
+            self.send(304, b"", "image/jpeg", {"ETag": etag})
+        else:
+            self.send(200, body, "image/jpeg", {"ETag": etag})
 
 
 class QuietServer(ThreadingHTTPServer):
@@ -235,7 +222,7 @@ def met_server(shared_data: Callable[..., Path]) -> Iterator[FakeMet]:
     templates = {k: json.loads((folder / name).read_text(encoding="utf-8")) for k, name in TEMPLATES.items()}
     departments = json.loads((folder / DEPARTMENTS).read_text(encoding="utf-8"))["departments"]
     met = FakeMet(templates, departments, (folder / BLOCK_PAGE).read_bytes())
-    server = QuietServer(("127.0.0.1", 0), _handler(met))
+    server = QuietServer(("127.0.0.1", 0), type("Handler", (MetHandler,), {"met": met}))
     met.url = f"http://127.0.0.1:{server.server_address[1]}"
     thread = threading.Thread(target=server.serve_forever, args=(0.05,), daemon=True)
     thread.start()
