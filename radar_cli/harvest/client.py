@@ -127,6 +127,12 @@ def looks_like_json(body: bytes) -> bool:
     return head in (b"{", b"[")
 
 
+def looks_like_html(body: bytes) -> bool:
+    """True when the body starts like an HTML page (where a file such as an image was expected)."""
+    head = body.lstrip()[:15].lower()
+    return head.startswith((b"<html", b"<!doctype html", b"<head", b"<body"))
+
+
 class HttpClient:
     """Paced, retrying GETs against one host budget.
 
@@ -234,6 +240,8 @@ class HttpClient:
         if status == 403:
             raise _Retry("HTTP 403 (block page)", block=True)
         if not expect_json:
+            if 200 <= status < 300 and looks_like_html(reply.body):  # a challenge page instead of the file
+                raise _Retry(f"HTML body with HTTP {status} (block page)", block=True)
             return reply
         if not looks_like_json(reply.body):
             if 200 <= status < 300:

@@ -5,16 +5,19 @@ Layout of the output folder:
     DATA/met/<id>.json         the object record exactly as the API sent it
     DATA/met/<id>.jpg          the validated image (name from the numeric id only)
     DATA/failures.csv          object_id,error of the objects that failed (rewritten at the end of each run)
+    DATA/.fetch.lock           held while a run writes the folder (one run per folder at a time)
 """
 
 from __future__ import annotations
 
 import csv
+import fcntl
 import io
+from contextlib import contextmanager
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Literal
+from typing import Callable, Iterator, Literal
 
 from tqdm import tqdm
 
@@ -266,6 +269,17 @@ def _write_failures(catalog: Catalog, out: Path) -> None:
     write_text(path, buf.getvalue())
 
 
+@contextmanager
+def _only_run(out: Path) -> Iterator[None]:
+    """Hold an exclusive lock on the folder for the run (released by the OS even on SIGKILL)."""
+    with open(out / ".fetch.lock", "w") as lock:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise InputError(f"{out}: another `radar fetch` is writing this folder") from None
+        yield
+
+
 def harvest(config: HarvestConfig, log: Callable[[str], None] = tqdm.write) -> Summary:
     """Harvest a Met collection query into `config.out`, resuming whatever an earlier run left.
 
@@ -279,7 +293,15 @@ def harvest(config: HarvestConfig, log: Callable[[str], None] = tqdm.write) -> S
         The run summary (catalog totals included).
     """
     out = Path(config.out)
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        with _only_run(out):
+            return _harvest(config, out, log)
+    except OSError as e:  # disk full, permissions: the catalog stays consistent, a rerun resumes
+        raise InputError(f"{out}: cannot write the harvest ({e})") from None
+
+
+def _harvest(config: HarvestConfig, out: Path, log: Callable[[str], None]) -> Summary:
     _remove_partial_files(out / OBJECTS_DIR)
     with open_catalog(out) as catalog:
         harvester = Harvester(config, catalog, log)

@@ -9,13 +9,14 @@ import os
 
 import pytest
 
+from radar_cli.errors import InputError
 from radar_cli.harvest import harvester as harvester_module
 from radar_cli.harvest.catalog import iter_images, open_catalog
 from radar_cli.harvest.harvester import harvest
 
 RECORD_FAULTS = {2: ("429",), 3: ("500", "503"), 4: ("slow",), 5: ("truncated",), 6: ("html403",),
                  7: ("html200",), 8: ("malformed",), 16: ("503",) * 4}  # FAST retries 3: four attempts, all 503
-IMAGE_FAULTS = {17: ("500",), 18: ("truncated",)}
+IMAGE_FAULTS = {17: ("500", "html403"), 18: ("truncated", "html200", "429")}
 EXPECTED = {
     **{i: ("image", "") for i in (1, 2, 3, 4, 5, 6, 7, 8, 17, 18)},
     9: ("skipped", "not_found"),
@@ -168,3 +169,16 @@ def test_outage_stops_the_run(met_server, harvest_config, monkeypatch):
     summary = harvest(harvest_config())
     assert "3 objects failed in a row" in summary.aborted
     assert summary.counts["failed"] == 3 and summary.counts["searched"] == 4
+
+
+def test_one_run_per_folder(met_server, harvest_config):
+    import fcntl
+
+    config = harvest_config()
+    config.out.mkdir(parents=True)
+    with open(config.out / ".fetch.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        with pytest.raises(InputError, match="another `radar fetch` is writing"):
+            harvest(config)
+    met_server.add(1)
+    assert harvest(config).counts["image"] == 1
