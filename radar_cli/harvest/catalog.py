@@ -128,6 +128,11 @@ class Catalog:
             "UPDATE objects SET state = 'image', reason = '', image_path = ?, bytes = ?, sha256 = ?, etag = ?, "
             "updated_at = ? WHERE object_id = ?", (image_path, size, sha256, etag, _now(), object_id))
 
+    def clear_image(self, object_id: int) -> None:
+        """Forget an object's stored image (its file was removed)."""
+        self.db.execute("UPDATE objects SET image_path = NULL, bytes = NULL, sha256 = NULL, etag = NULL, "
+                        "updated_at = ? WHERE object_id = ?", (_now(), object_id))
+
     def set_state(self, object_id: int, state: str, reason: str = "") -> None:
         """Move an object to `skipped` or `failed` (with its reason or error), or back to an earlier state."""
         assert state in STATES, state

@@ -209,8 +209,16 @@ class Harvester:
             state, reason = "skipped", "not_public_domain"
         elif not image_url:
             state, reason = "skipped", "no_image"
+        if state == "skipped":
+            self._drop_image(object_id)  # a --since refetch may withdraw an image kept before
         self.catalog.set_record(object_id, record, record_path, image_url, state, reason)
         self.summary.records_fetched += 1
+
+    def _drop_image(self, object_id: int) -> None:
+        row = self.catalog.get(object_id)
+        if row is not None and row["image_path"]:
+            (Path(self.config.out) / row["image_path"]).unlink(missing_ok=True)
+            self.catalog.clear_image(object_id)
 
     def _image(self, object_id: int) -> None:
         row = self.catalog.get(object_id)

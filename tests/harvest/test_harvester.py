@@ -103,11 +103,14 @@ def test_since_refetches_only_changed_records(met_server, harvest_config):
     config = harvest_config()
     harvest(config)
     met_server.objects[2].update(title="Renamed vase", metadataDate="2026-11-01T00:00:00.000Z")
+    met_server.objects[3].update(isPublicDomain=False, metadataDate="2026-11-02T00:00:00.000Z")
     summary = harvest(dataclasses.replace(config, since="2026-10-01"))
-    assert [met_server.hits(f"/api/v1/objects/{i}") for i in range(1, 5)] == [1, 2, 1, 1]
-    assert summary.records_fetched == 1 and summary.images_unchanged == 1 and summary.images_fetched == 0
+    assert [met_server.hits(f"/api/v1/objects/{i}") for i in range(1, 5)] == [1, 2, 2, 1]
+    assert summary.records_fetched == 2 and summary.images_unchanged == 1 and summary.images_fetched == 0
     titles = {e.object_id: e.title for e in iter_images(config.out)}
-    assert titles[2] == "Renamed vase" and len(titles) == 4
+    assert titles[2] == "Renamed vase" and sorted(titles) == [1, 2, 4]
+    assert states(config.out)[3] == ("skipped", "not_public_domain")
+    assert not (config.out / "met" / "3.jpg").exists()  # no longer public domain: its image is removed
 
 
 def test_ids_file_limit_small_images_and_all(met_server, harvest_config, tmp_path):
