@@ -18,6 +18,7 @@ COMMANDS: list[tuple[str, str]] = [
     ("radar_cli.cli.synth", "synth"),
     ("radar_cli.cli.derender", "derender"),
     ("radar_cli.cli.relight", "relight"),
+    ("radar_cli.cli.eval", "eval"),
 ]
 
 

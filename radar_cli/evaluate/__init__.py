@@ -1,0 +1,1 @@
+"""`radar eval`: the paper's metrics (Table 2) of de-rendering results against synthetic ground truth."""
