@@ -171,3 +171,10 @@ def test_real_photos_give_one_plausible_crop_each():
         assert len(found) == 1
         s = found[0].scores
         assert 0.2 < s["area"] < 0.6 and s["symmetry"] > 0.8, s
+
+
+def test_bench_masks_smoke():
+    from radar_cli.masks.benchmark import bench_masks
+
+    result = bench_masks(n_photos=2, long_side=1600, workers=1)
+    assert result["photos"] == 2 and result["photos_per_second"] > 0 and result["cpu_seconds_per_photo"] > 0
