@@ -61,8 +61,9 @@ def catalog_sources(data_dir: Path) -> list[Source]:
             for e in iter_images(data_dir)]
 
 
-def list_sources(data_dir: str | Path) -> list[Source]:
-    """The photographs under `data_dir`: from its harvest catalog if it has one, else every image file."""
+def list_sources(data_dir: str | Path, exclude: Path | None = None) -> list[Source]:
+    """The photographs under `data_dir`: from its harvest catalog if it has one, else every image file
+    (except those under `exclude`, the output folder, should it lie inside `data_dir`)."""
     data_dir = Path(data_dir)
     if not data_dir.is_dir():
         raise InputError(f"{data_dir}: no such folder")
@@ -70,7 +71,9 @@ def list_sources(data_dir: str | Path) -> list[Source]:
 
     if (data_dir / CATALOG_NAME).is_file():
         return catalog_sources(data_dir)
-    files = sorted(p for p in data_dir.rglob("*") if p.is_file() and p.suffix.lower() in PHOTO_EXTENSIONS)
+    skip = exclude.resolve() if exclude is not None else None
+    files = sorted(p for p in data_dir.rglob("*") if p.is_file() and p.suffix.lower() in PHOTO_EXTENSIONS
+                   and not (skip and p.resolve().is_relative_to(skip)))
     keys = Counter(safe_id(p.stem) for p in files)
     return [Source(safe_id(p.stem) if keys[safe_id(p.stem)] == 1 else safe_id(str(p.relative_to(data_dir))), p,
                    {"file": str(p.relative_to(data_dir))}) for p in files]
@@ -168,7 +171,7 @@ def prepare(data_dir: str | Path, out: str | Path, settings: Settings = Settings
         The run's Summary over all records (this run's and earlier ones').
     """
     out = Path(out)
-    sources = list_sources(data_dir)
+    sources = list_sources(data_dir, exclude=out)
     if spec.name == "onnx":
         _detector(spec)  # fail early, in this process, on a missing runtime or a bad model
     done = {p.stem for p in (out / RECORDS).glob("*.json")}

@@ -41,6 +41,14 @@ def test_catalog_folder_gives_attribution_in_meta(tmp_path):
     assert meta["attribution"]["title"] == "Jar" and meta["attribution"]["licence"] == "CC0-1.0"
 
 
+def test_output_inside_the_photo_folder_is_not_read_back(tmp_path):
+    Image.fromarray(_studio(2)).save(tmp_path / "vase.png")
+    prepare(tmp_path, tmp_path / "prepared", progress=False)
+    assert [s.key for s in list_sources(tmp_path, exclude=tmp_path / "prepared")] == ["vase"]
+    again = prepare(tmp_path, tmp_path / "prepared", progress=False)
+    assert again.photos == 1 and again.skipped_done == 1
+
+
 def test_missing_folder_is_an_input_error(tmp_path):
     with pytest.raises(InputError):
         list_sources(tmp_path / "nope")
