@@ -55,43 +55,36 @@ class Crop:
         return not self.reasons
 
     def original_box(self) -> list[float]:
-        """The crop window [x0, y0, side] in the ORIGINAL photo's pixels."""
+        """The crop window [x0, y0, side] in the original photo's pixels (upright, after EXIF rotation)."""
         s = self.photo_scale
         return [round(self.box.x0 / s, 1), round(self.box.y0 / s, 1), round(self.box.side / s, 1)]
 
 
-def load_photo(path: str | Path, min_long_side: int = 1024) -> tuple[np.ndarray, float, tuple[int, int]]:
-    """Read a photo as H x W x 3 uint8 RGB; big JPEGs are decoded at 1/2, 1/4 or 1/8 scale (DCT draft) when
-    that still leaves a long edge >= `min_long_side`.
+def load_photo(path: str | Path, min_long_side: int = 1024) -> tuple[np.ndarray, float]:
+    """Read a photo as H x W x 3 uint8 RGB, upright (EXIF orientation applied). Big JPEGs are decoded at 1/2,
+    1/4 or 1/8 scale (DCT draft, several times faster) when that still leaves a long edge >= `min_long_side`;
+    other formats go through `fileio.read_image` (grey, RGBA, CMYK, 16-bit, bomb limit).
 
     Returns:
-        (image, scale = decoded pixels per original pixel, original (width, height)).
+        (image, scale = decoded pixels per pixel of the upright original).
     """
     path = Path(path)
     try:
         with Image.open(path) as im:
-            original = im.size
-            if im.format != "JPEG":
-                raise _NotJpeg
-            want = min_long_side / max(original)
-            if want < 0.5:
-                im.draft("RGB", (max(1, int(original[0] * want)), max(1, int(original[1] * want))))
-            im = ImageOps.exif_transpose(im)
-            rgb = np.asarray(im.convert("RGB")).copy()
-            return rgb, _decoded_scale(rgb, original), original
-    except _NotJpeg:
-        image = read_image(path, "RGB")
-        return image, 1.0, (image.shape[1], image.shape[0])
+            if im.format == "JPEG":
+                original = im.size
+                want = min_long_side / max(original)
+                if want < 0.5:
+                    im.draft("RGB", (max(1, int(original[0] * want)), max(1, int(original[1] * want))))
+                rgb = np.asarray(ImageOps.exif_transpose(im).convert("RGB")).copy()
+                return rgb, _decoded_scale(rgb, original)
     except FileNotFoundError:
         raise InputError(f"{path}: no such file") from None
     except Image.DecompressionBombError as e:
         raise InputError(f"{path}: image too large ({e})") from None
     except (OSError, ValueError, SyntaxError) as e:
         raise InputError(f"{path}: not a readable image ({e})") from None
-
-
-class _NotJpeg(Exception):
-    pass
+    return read_image(path, "RGB"), 1.0
 
 
 def _decoded_scale(rgb: np.ndarray, original: tuple[int, int]) -> float:
@@ -149,6 +142,6 @@ def process_image(image: np.ndarray, settings: Settings, detector: Detector = de
 
 def process_photo(path: str | Path, settings: Settings, detector: Detector = detect) -> list[Crop]:
     """Load a photo file and return its crops, with crop boxes in the original photo's pixels."""
-    image, scale, _ = load_photo(path, min_long_side=max(768, 3 * settings.size))
+    image, scale = load_photo(path, min_long_side=max(768, 3 * settings.size))
     found = process_image(image, settings, detector, str(path))
     return [Crop(c.image, c.mask, c.box, scale, c.scores, c.reasons) for c in found]

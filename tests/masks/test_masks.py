@@ -178,3 +178,16 @@ def test_bench_masks_smoke():
 
     result = bench_masks(n_photos=2, long_side=1600, workers=1)
     assert result["photos"] == 2 and result["photos_per_second"] > 0 and result["cpu_seconds_per_photo"] > 0
+
+
+def test_big_jpeg_is_draft_decoded_and_box_is_in_original_pixels(tmp_path):
+    from radar_cli.masks.pipeline import load_photo, process_photo
+
+    img = np.full((2400, 3200, 3), 190, np.uint8)
+    img[600:1800, 1400:1800] = (40, 60, 120)  # a 1200 x 400 px upright block
+    Image.fromarray(img).save(tmp_path / "big.jpg", quality=92)
+    decoded, scale = load_photo(tmp_path / "big.jpg", min_long_side=768)
+    assert scale == 0.25 and decoded.shape == (600, 800, 3)
+    (found,) = process_photo(tmp_path / "big.jpg", Settings())
+    x0, y0, side = found.original_box()
+    assert abs(side - 1200 / 0.85) < 30 and abs(x0 + side / 2 - 1600) < 15 and abs(y0 + side / 2 - 1200) < 15
