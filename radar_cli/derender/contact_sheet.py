@@ -41,6 +41,8 @@ def contact_sheet(root: str | Path, out: str | Path, env: str = "studio") -> Pat
         The path written.
     """
     root = Path(root)
+    if not root.is_dir():
+        raise InputError(f"{root}: no such results folder")
     records = read_records(root)[:MAX_ROWS]
     if not records:
         raise InputError(f"{root}: no de-rendered objects to put on a contact sheet")

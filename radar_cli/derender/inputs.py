@@ -3,6 +3,7 @@ into the network's square input crop (locating the object in photos that are not
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -25,12 +26,14 @@ class InputItem:
     Attributes:
         name: the object's folder name under RESULTS (unique within a run, [A-Za-z0-9._-]).
         image_path: the photo.
-        mask_path: a known silhouette (prepared dataset or --masks), used to crop; None if unknown.
+        mask_path: a known silhouette (--masks), used to crop; None if unknown.
+        is_crop: the image is already a network crop (a prepared dataset sample): used whole.
     """
 
     name: str
     image_path: Path
     mask_path: Path | None = None
+    is_crop: bool = False
 
 
 @dataclass(frozen=True)
@@ -63,13 +66,13 @@ def _is_image(path: Path) -> bool:
     return path.suffix.lower() in IMAGE_SUFFIXES and not path.name.startswith(".")
 
 
-def _folder_items(folder: Path, masks: Path | None) -> list[tuple[str, Path, Path | None]]:
-    """(name, image, mask) for a prepared dataset (<split>/<id>/image.png) or every image under a folder."""
+def _folder_items(folder: Path, masks: Path | None) -> list[InputItem]:
+    """Items (names not yet unique) of a prepared dataset (<split>/<id>/image.png) or every image under a folder."""
     if is_dataset(folder):
         found = sorted(folder.glob(f"*/*/{IMAGE_FILE}"))
-        return [(f"{p.parent.parent.name}_{p.parent.name}", p, _existing(p.parent / MASK_FILE)) for p in found]
+        return [InputItem(f"{p.parent.parent.name}_{p.parent.name}", p, is_crop=True) for p in found]
     images = sorted(p for p in folder.rglob("*") if p.is_file() and _is_image(p))
-    return [(p.stem, p, _mask_for(p, masks)) for p in images]
+    return [InputItem(p.stem, p, _mask_for(p, masks)) for p in images]
 
 
 def _existing(path: Path) -> Path | None:
@@ -101,7 +104,7 @@ def collect_inputs(paths: list[str | Path], masks: str | Path | None = None) -> 
     masks_dir = Path(masks) if masks is not None else None
     if masks_dir is not None and not masks_dir.is_dir():
         raise InputError(f"{masks_dir}: --masks folder does not exist")
-    found: list[tuple[str, Path, Path | None]] = []
+    found: list[InputItem] = []
     failures: list[Failure] = []
     for raw in paths:
         path = Path(raw)
@@ -112,7 +115,7 @@ def collect_inputs(paths: list[str | Path], masks: str | Path | None = None) -> 
             found.extend(items)
         elif path.is_file():
             if _is_image(path):
-                found.append((path.stem, path, _mask_for(path, masks_dir)))
+                found.append(InputItem(path.stem, path, _mask_for(path, masks_dir)))
             else:
                 failures.append(Failure(str(path), f"not an image file (expected {', '.join(IMAGE_SUFFIXES)})"))
         else:
@@ -120,45 +123,47 @@ def collect_inputs(paths: list[str | Path], masks: str | Path | None = None) -> 
     return _unique(found, failures), failures
 
 
-def _unique(found: list[tuple[str, Path, Path | None]], failures: list[Failure]) -> list[InputItem]:
-    """InputItems with safe, unique names; the same file given twice is de-rendered once."""
+def _unique(found: list[InputItem], failures: list[Failure]) -> list[InputItem]:
+    """The items with safe, unique names; the same file given twice is de-rendered once."""
     items, names, seen = [], set(), set()
-    for stem, image, mask in found:
-        key = image.resolve()
+    for item in found:
+        key = item.image_path.resolve()
         if key in seen:
             continue
         seen.add(key)
         try:
-            base = safe_id(stem)
+            base = safe_id(item.name)
         except InputError as e:
-            failures.append(Failure(str(image), str(e)))
+            failures.append(Failure(str(item.image_path), str(e)))
             continue
         name, k = base, 2
         while name.lower() in names:
             name, k = f"{base}-{k}", k + 1
         names.add(name.lower())
-        items.append(InputItem(name, image, mask))
+        items.append(dataclasses.replace(item, name=name))
     return items
 
 
-def locate(photo: np.ndarray, mask: np.ndarray | None) -> CropBox:
-    """The square crop around the object: from a known silhouette, else from radar masks' detector.
+def locate(photo: np.ndarray, size: int, name: str) -> tuple[np.ndarray, CropBox]:
+    """The object's square crop, cut exactly as `radar masks` cuts its training crops (detect, GrabCut, frame).
 
     Args:
         photo: H x W x 3 uint8.
-        mask: H x W bool known silhouette, or None.
-    """
-    if mask is not None:
-        box = mask_box(mask)
-        if box is None:
-            raise InputError("the given mask is empty")
-        return square_box(box)
-    from radar_cli.masks.detect import detect
+        size: S, the crop side.
+        name: the file, for messages.
 
+    Returns:
+        (S x S x 3 uint8 crop, its window in the photo).
+    """
+    from radar_cli.masks.detect import detect
+    from radar_cli.masks.pipeline import Settings, check_photo, crop_detection
+
+    check_photo(photo, name)
     found = detect(photo)
     if not found:
-        raise InputError("no object stands out from the backdrop; crop it square or use --crop none")
-    return square_box(found[0].box)
+        raise InputError(f"{name}: no object stands out from the backdrop; crop it square or use --crop none")
+    crop = crop_detection(photo, found[0], Settings(size=size))
+    return crop.image, crop.box
 
 
 def whole_photo(photo: np.ndarray) -> CropBox:
@@ -169,8 +174,10 @@ def whole_photo(photo: np.ndarray) -> CropBox:
 
 
 def prepare(item: InputItem, size: int, crop: CropMode = "auto") -> Prepared:
-    """Read a photo and cut the network's input: square photos are used whole, others are cropped around the
-    object (`auto`) or padded to a square (`none`).
+    """Read a photo and cut the network's input.
+
+    `auto` locates the object and crops around it (from the --masks silhouette if given, else as `radar masks`
+    does); `none` pads the whole photo to a square. Dataset samples are crops already and are used whole.
 
     Args:
         item: the input.
@@ -182,16 +189,15 @@ def prepare(item: InputItem, size: int, crop: CropMode = "auto") -> Prepared:
     """
     photo = read_image(item.image_path, "RGB")
     h, w = photo.shape[:2]
-    mask = None
-    if item.mask_path is not None:
-        mask = read_image(item.mask_path, "L") > 127
-        if mask.shape != (h, w):
-            raise InputError(f"{item.mask_path}: mask size {mask.shape} does not match the photo's {(h, w)}")
-    if crop == "auto" and (h != w or mask is not None):
-        try:
-            box = locate(photo, mask)
-        except InputError as e:
-            raise InputError(f"{item.image_path}: {e}") from None
-    else:
+    if item.is_crop or crop == "none":
         box = whole_photo(photo)
-    return Prepared(np.ascontiguousarray(cut(photo, box, size)), box, (w, h))
+        return Prepared(cut(photo, box, size), box, (w, h))
+    if item.mask_path is None:
+        image, box = locate(photo, size, str(item.image_path))
+        return Prepared(image, box, (w, h))
+    mask = read_image(item.mask_path, "L") > 127
+    bounds = mask_box(mask) if mask.shape == (h, w) else None
+    if bounds is None:
+        raise InputError(f"{item.mask_path}: mask is empty or its size {mask.shape} is not the photo's {(h, w)}")
+    box = square_box(bounds)
+    return Prepared(cut(photo, box, size), box, (w, h))

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import torch
+import torch.nn.functional as F
 from PIL import Image
 
 from radar_cli.config import CameraConfig
@@ -137,6 +138,16 @@ def write_turntable(folder: Path, view: ViewRenderer, frames: int) -> None:
                        loop=0)
 
 
+def texture_for_size(state: ObjectState, size: int) -> ObjectState:
+    """The object with its albedo averaged down to about one texel per pixel of a size x size view (the full
+    map is 3x wider): small views then shade and sample a texture of their own scale."""
+    rows = state.albedo.shape[2]
+    if rows <= size:
+        return state
+    albedo = F.interpolate(state.albedo, size=(size, 3 * size), mode="area")  # 1 x 3 x S x 3S
+    return dataclasses.replace(state, albedo=albedo)
+
+
 def relit_file(name: str) -> str:
     """File name of the view relit under environment `name`."""
     return f"{RELIT_PREFIX}{name}.png"
@@ -154,7 +165,7 @@ def write_renders(folder: Path, state: ObjectState, input_size: int, view_size: 
     """Every render of one object."""
     write_input_view(folder, state, input_size)
     write_image(folder / MATERIAL_SPHERE_FILE, material_sphere(state, view_size))
-    view = ViewRenderer(state, view_size)
+    view = ViewRenderer(texture_for_size(state, view_size), view_size)
     if frames > 0:
         write_turntable(folder, view, frames)
     write_relit(folder, view, envs)

@@ -1,0 +1,82 @@
+"""Loading a checkpoint into the predictor: a tiny randomly initialised RadarModel end to end, and a clear error
+for weights that do not fit their config."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from radar_cli.cli import cli
+from radar_cli.derender.predictor import Predictor
+from radar_cli.errors import CheckpointError
+
+from .conftest import write_photo
+
+checkpoint = pytest.importorskip("radar_cli.train.checkpoint")
+model_config = pytest.importorskip("radar_cli.model.config")
+
+
+def tiny_config(width: int = 4):
+    from radar_cli.config import GeometryConfig, RenderConfig
+
+    render = RenderConfig(image_size=32, tex_height=16, tex_width=16, env_height=4, env_width=12,
+                          shading_height=8, shading_width=8)
+    model = model_config.ModelConfig(render=render, geometry=GeometryConfig(n_rows=16, n_cols=24),
+                                     shape_width=width, light_width=width, albedo_width=width, disc_width=width,
+                                     max_channels=16, latent=8, albedo_depth=2)
+    return model_config.RunConfig(model=model, loss=model_config.LossConfig(sad_patch=8)).validate()
+
+
+def save_weights(path: Path, config, weights_config=None) -> Path:
+    """An exported-weights file: the model's tensors of `weights_config` (default: config) + `config` as JSON."""
+    from safetensors.torch import save_file
+
+    from radar_cli.model.radar import RadarModel
+
+    model = RadarModel((weights_config or config).model)
+    tensors = {f"model.{k}": v.contiguous() for k, v in model.state_dict().items()}
+    meta = {"format": checkpoint.FORMAT, "config": json.dumps(model_config.to_dict(config)), "step": "0"}
+    save_file(tensors, str(path), metadata=meta)
+    return path
+
+
+def test_tiny_model_predicts(tmp_path: Path) -> None:
+    path = save_weights(tmp_path / "tiny.safetensors", tiny_config())
+    predictor = Predictor.from_checkpoint(path, "cpu")
+    assert predictor.setup.image_size == 32 and predictor.version.startswith("tiny.safetensors#")
+    dec = predictor.predict([np.full((32, 32, 3), 128, np.uint8)] * 2)
+    assert dec.radius.shape == (2, 16) and dec.albedo.shape == (2, 3, 16, 16) and dec.env.shape == (2, 4, 12)
+    assert not dec.radius.requires_grad
+
+
+def test_cli_with_a_real_checkpoint(tmp_path: Path) -> None:
+    path = save_weights(tmp_path / "tiny.safetensors", tiny_config())
+    write_photo(tmp_path / "in" / "a.png", 1, (80, 80))
+    result = CliRunner().invoke(cli, ["derender", str(tmp_path / "in"), "--out", str(tmp_path / "out"),
+                                      "--checkpoint", str(path), "--views", "2", "--view-size", "32",
+                                      "--device", "cpu"])
+    assert result.exit_code == 0, result.output
+    material = json.loads((tmp_path / "out" / "a" / "material.json").read_text())
+    assert material["model"].startswith("tiny.safetensors#") and material["image_size"] == 32
+
+
+def test_checkpoint_from_another_config_is_one_clear_error(tmp_path: Path) -> None:
+    config = tiny_config(4)
+    path = save_weights(tmp_path / "other.safetensors", config, weights_config=tiny_config(8))
+    with pytest.raises(CheckpointError, match="other.safetensors"):
+        Predictor.from_checkpoint(path, "cpu")
+    write_photo(tmp_path / "in" / "a.png", 1, (80, 80))
+    result = CliRunner().invoke(cli, ["derender", str(tmp_path / "in"), "--out", str(tmp_path / "out"),
+                                      "--checkpoint", str(path)])
+    assert result.exit_code == 2
+    (line,) = result.output.strip().splitlines()
+    assert line.startswith("Error: ") and "other.safetensors" in line and "fit" in line
+
+
+def test_missing_checkpoint(tmp_path: Path) -> None:
+    with pytest.raises(CheckpointError, match="no such checkpoint"):
+        Predictor.from_checkpoint(tmp_path / "nope.safetensors", "cpu")

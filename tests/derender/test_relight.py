@@ -1,0 +1,114 @@
+"""Relighting a de-rendered folder without the network, environment maps, the fast view renderer, contact sheet."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from PIL import Image
+
+from radar_cli.cli import cli
+from radar_cli.derender.batch import DerenderOptions, derender
+from radar_cli.derender.contact_sheet import contact_sheet
+from radar_cli.derender.environments import builtin_environments, load_environment, normalise
+from radar_cli.derender.export import ExportConfig
+from radar_cli.derender.renders import ViewRenderer
+from radar_cli.derender.state import read_state
+from radar_cli.errors import InputError
+from radar_cli.render.scene import render_view
+
+from .conftest import SIZE, write_photo
+
+
+@pytest.fixture(scope="module")
+def obj(tmp_path_factory) -> Path:
+    from .conftest import SETUP, FakeModel
+    from radar_cli.derender.predictor import Predictor
+
+    root = tmp_path_factory.mktemp("relight")
+    write_photo(root / "in" / "vase.png", 7, (80, 80))
+    predictor = Predictor(FakeModel(), SETUP, "fake-model", "cpu")
+    derender([root / "in"], predictor, DerenderOptions(out=root / "out", export=ExportConfig(0, 32)))
+    return root / "out" / "vase"
+
+
+def _read(path: Path) -> np.ndarray:
+    return np.asarray(Image.open(path).convert("RGB"), dtype=np.float64)
+
+
+def test_relight_with_predicted_env_reproduces_recon(obj: Path, tmp_path: Path) -> None:
+    out = tmp_path / "again.png"
+    result = CliRunner().invoke(cli, ["relight", str(obj), "--env", str(obj / "env_map.npy"), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    again, recon = _read(out), _read(obj / "recon.png")
+    assert again.shape == recon.shape == (SIZE, SIZE, 3)
+    assert np.abs(again - recon).max() <= 1.0  # the same render, up to float rounding
+
+
+def test_relight_changes_with_env_and_view(obj: Path, tmp_path: Path) -> None:
+    recon = _read(obj / "recon.png")
+    hdr = tmp_path / "sunset.hdr"
+    cv2.imwrite(str(hdr), np.repeat(builtin_environments(16, 48)["sunset"][..., None], 3, 2))
+    runner = CliRunner()
+    assert runner.invoke(cli, ["relight", str(obj), "--env", str(hdr), "--out", str(tmp_path / "a.png")]).exit_code == 0
+    assert np.abs(_read(tmp_path / "a.png") - recon).mean() > 2
+    args = ["relight", str(obj), "--env", str(obj / "env_map.npy"), "--yaw", "90", "--pitch", "0", "--size", "48",
+            "--out", str(tmp_path / "b.png")]
+    assert runner.invoke(cli, args).exit_code == 0
+    assert Image.open(tmp_path / "b.png").size == (48, 48)
+
+
+def test_relight_bad_folder_and_env_one_line(obj: Path, tmp_path: Path) -> None:
+    runner = CliRunner()
+    bad = runner.invoke(cli, ["relight", str(tmp_path), "--env", str(obj / "env_map.npy"), "--out", "x.png"])
+    assert bad.exit_code == 2 and "material.json" in bad.output and len(bad.output.strip().splitlines()) == 1
+    (tmp_path / "env.npy").write_bytes(b"not numpy")
+    bad_env = runner.invoke(cli, ["relight", str(obj), "--env", str(tmp_path / "env.npy"), "--out", "x.png"])
+    assert bad_env.exit_code == 2 and "env.npy" in bad_env.output
+
+
+def test_view_renderer_equals_render_view(obj: Path) -> None:
+    state = read_state(obj)
+    view = ViewRenderer(state, 40, pitch_deg=5.0)
+    fast = view.draw(view.shading(), yaw_deg=100.0).astype(np.float64)
+    pose = state.pose.clone()
+    pose[:, 0] = 5.0
+    ref, _ = render_view(state.radius, state.height, pose, state.albedo, state.env, state.alpha, state.rho, 40,
+                         100.0, state.render, state.camera, 1.0)
+    ref8 = np.clip(ref[0].permute(1, 2, 0).numpy(), 0, 1) * 255
+    assert np.abs(fast - ref8).max() <= 1.0
+
+
+def test_environment_files_agree(tmp_path: Path) -> None:
+    env = builtin_environments(8, 24)["studio"]
+    np.save(tmp_path / "e.npy", env)
+    cv2.imwrite(str(tmp_path / "e.hdr"), np.repeat(env[..., None], 3, 2))
+    big = cv2.resize(env, (96, 32), interpolation=cv2.INTER_NEAREST)
+    Image.fromarray((np.clip(big / big.max(), 0, 1) ** (1 / 2.2) * 255).astype(np.uint8)).save(tmp_path / "e.png")
+    from_npy = load_environment(tmp_path / "e.npy", 8, 24)
+    np.testing.assert_allclose(load_environment(tmp_path / "e.hdr", 8, 24), from_npy, rtol=0.02, atol=1e-4)
+    from_png = load_environment(tmp_path / "e.png", 8, 24) * env.max()
+    np.testing.assert_allclose(from_png, env, atol=0.03 * env.max())
+    with pytest.raises(InputError, match="unsupported"):
+        load_environment(shutil.copy(tmp_path / "e.npy", tmp_path / "e.txt"), 8, 24)
+
+
+def test_builtins_are_normalised() -> None:
+    envs = builtin_environments(16, 48)
+    assert set(envs) == {"studio", "sunset", "overcast", "two_lights"}
+    for env in envs.values():
+        assert env.min() >= 0 and np.isfinite(env).all()
+        np.testing.assert_allclose(normalise(env), env, rtol=1e-4)  # already at the target irradiance
+    assert envs["sunset"][:, :24].sum() < envs["sunset"][:, 24:].sum()  # the sun is on one side
+
+
+def test_contact_sheet(obj: Path, tmp_path: Path) -> None:
+    out = contact_sheet(obj.parent, tmp_path / "sheet.png")
+    with Image.open(out) as im:
+        assert im.size[1] > 100 and im.size[0] > 4 * 100
+    with pytest.raises(InputError):
+        contact_sheet(tmp_path / "nothing", tmp_path / "x.png")
