@@ -23,7 +23,7 @@ import torch
 from tqdm import tqdm
 
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig, to_dict
-from radar_cli.dataset import SPLITS, SampleRef, sample_ref, write_sample
+from radar_cli.dataset import IMAGE_FILE, MASK_FILE, SPLITS, SampleRef, sample_ref, write_sample
 from radar_cli.errors import ConfigError, InputError, RadarError
 from radar_cli.fileio import write_image, write_json, write_npy, write_text
 from radar_cli.synth import layout
@@ -131,8 +131,8 @@ def make_sample(cfg: SynthConfig, split: str, index: int, textures: list[Path] |
         layout.SPECULAR_FILE: out.specular.astype(np.float16),
         layout.ENV_MAP_FILE: env.astype(np.float32),
         layout.ENV_PREVIEW_FILE: env_preview(env, render.gamma),
-        "image": out.image,
-        "mask": out.mask,
+        IMAGE_FILE: out.image,
+        MASK_FILE: out.mask,
     }
     params = {
         "radius": [round(float(x), 6) for x in shape.radius], "height": round(shape.height, 6),
@@ -150,7 +150,7 @@ def write_sample_folder(root: Path, split: str, sid: str, files: dict, params: d
     tmp = root / PARTIAL_DIR / f"{split}-{sid}-{os.getpid()}"
     shutil.rmtree(tmp, ignore_errors=True)
     tmp.mkdir(parents=True)
-    write_sample(SampleRef(tmp.parent, "", tmp.name), files.pop("image"), files.pop("mask"))
+    write_sample(SampleRef(tmp.parent, "", tmp.name), files.pop(IMAGE_FILE), files.pop(MASK_FILE))
     for name, arr in files.items():
         if name.endswith(".npy"):
             write_npy(tmp / name, arr)

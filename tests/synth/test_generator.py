@@ -8,9 +8,10 @@ import shutil
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from PIL import Image
 
 from radar_cli.cli import cli
-from radar_cli.dataset import list_samples, read_sample
+from radar_cli.dataset import IMAGE_FILE, list_samples, read_sample
 from radar_cli.errors import ConfigError
 from radar_cli.fileio import read_image
 from radar_cli.synth import layout
@@ -80,8 +81,8 @@ def test_make_sample_is_a_pure_function_of_seed_split_index():
     f1, p1 = make_sample(TINY, "test", 4, None)
     f2, p2 = make_sample(TINY, "test", 4, None)
     f3, _ = make_sample(TINY, "train", 4, None)
-    assert p1 == p2 and np.array_equal(f1["image"], f2["image"])
-    assert not np.array_equal(f1["image"], f3["image"])
+    assert p1 == p2 and np.array_equal(f1[IMAGE_FILE], f2[IMAGE_FILE])
+    assert not np.array_equal(f1[IMAGE_FILE], f3[IMAGE_FILE])
 
 
 def test_cli_synth_writes_splits_and_reports(tmp_path):
@@ -105,6 +106,15 @@ def test_cli_synth_with_texture_folder_and_bad_texture(tmp_path):
     result = CliRunner().invoke(cli, args)
     assert result.exit_code == 1
     assert "broken.png" in result.output and (tmp_path / "o" / layout.FAILURES_FILE).is_file()
+    (tex / "broken.png").unlink()
+    stripes = np.zeros((20, 30, 3), np.uint8)
+    stripes[:, ::4] = (200, 40, 10)
+    Image.fromarray(stripes).save(tex / "stripes.png")
+    args[args.index("--out") + 1] = str(tmp_path / "ok")
+    ok = CliRunner().invoke(cli, args)
+    assert ok.exit_code == 0, ok.output
+    params = json.loads((tmp_path / "ok/test/000000" / layout.PARAMS_FILE).read_text())
+    assert params["texture"]["source"] == "stripes.png"
     shutil.rmtree(tex)
     tex.mkdir()
     assert CliRunner().invoke(cli, args).exit_code == 2  # no texture images: one-line error
