@@ -76,7 +76,6 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--per-kind", type=int, default=50)
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--dump", help="folder to write the worst composite of each kind into")
     args = parser.parse_args()
     cv2.setNumThreads(1)
     t0 = time.time()
