@@ -32,7 +32,7 @@ def masks(data, out, size, margin, min_symmetry, workers, detector, model, no_co
     accepted = ", ".join(f"{k} {v}" for k, v in sorted(s.accepted.items())) or "none"
     click.echo(f"{s.photos} photos ({s.skipped_done} already done): accepted {accepted}; rejected {s.rejected} "
                f"{s.reasons or ''}; no object {s.no_object}; unreadable {s.failed}; "
-               f"{s.photos_per_second} photos/s")
+               f"{s.photos_per_second or '-'} photos/s")
     for sheet in s.sheets:
         click.echo(f"contact sheet: {sheet}")
     if s.failed:

@@ -204,7 +204,7 @@ def _summarise(records: list[dict], skipped: int, elapsed: float, processed: int
                 accepted[c["split"]] += 1
             else:
                 s.rejected += 1
-                reasons.update(reason.split(" ")[0] if reason[0].isalpha() else reason for reason in c["reasons"])
+                reasons.update(reason.split(" ")[0].rstrip(":") for reason in c["reasons"])
     s.accepted, s.reasons = dict(accepted), dict(reasons)
     return s
 

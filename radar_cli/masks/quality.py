@@ -141,7 +141,7 @@ def judge(scores: dict, limits: Thresholds) -> list[str]:
     if scores["area"] > limits.max_area:
         reasons.append(f"area {scores['area']:.3f} > {limits.max_area}")
     if scores["touches_border"] and not limits.allow_border:
-        reasons.append("object touches the photo's edge")
+        reasons.append("border: object touches the photo's edge")
     if scores["solidity"] < limits.min_solidity:
         reasons.append(f"solidity {scores['solidity']:.2f} < {limits.min_solidity}")
     if scores["symmetry"] < limits.min_symmetry:
