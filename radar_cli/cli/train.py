@@ -1,0 +1,33 @@
+"""`radar train`: train RADAR from a pipelines/*.toml preset on a dataset folder."""
+
+from __future__ import annotations
+
+import click
+
+from radar_cli.model.config import load_run_config
+
+
+@click.command("train")
+@click.option("--config", "config_path", required=True, type=click.Path(dir_okay=False),
+              help="Preset TOML, e.g. pipelines/syn_vases_cpu.toml.")
+@click.option("--data", "data_dir", required=True, type=click.Path(file_okay=False),
+              help="Dataset root holding train/<id>/image.png + mask.png.")
+@click.option("--out", "run_dir", required=True, type=click.Path(file_okay=False),
+              help="Run folder for checkpoints, metrics.jsonl, images and the loss curve.")
+@click.option("--resume", is_flag=True, help="Continue from the newest checkpoint in --out.")
+@click.option("--device", type=click.Choice(["auto", "cpu", "cuda"]), default=None,
+              help="Overrides train.device of the preset.")
+@click.option("--overfit", type=click.IntRange(min=1), default=None, help="Train on the first N samples only.")
+@click.option("--iterations", type=click.IntRange(min=0), default=None, help="Overrides train.iterations.")
+def train(config_path: str, data_dir: str, run_dir: str, resume: bool, device: str | None, overfit: int | None,
+          iterations: int | None) -> None:
+    """Train the de-rendering model (shape, lighting, albedo networks + SAD discriminator)."""
+    from radar_cli.train.trainer import train as run_training
+
+    summary = run_training(load_run_config(config_path), data_dir, run_dir, resume=resume, device=device,
+                           overfit=overfit, iterations=iterations)
+    losses = "  ".join(f"{k}={v:.4f}" for k, v in summary.losses.items())
+    click.echo(f"trained steps {summary.start}..{summary.end} in {summary.seconds:.1f} s "
+               f"({summary.sec_per_step:.3f} s/step)")
+    click.echo(f"final losses: {losses}")
+    click.echo(f"checkpoint: {summary.checkpoint}")

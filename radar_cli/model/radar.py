@@ -1,0 +1,67 @@
+"""RadarModel: image -> Decomposition, chaining f_S, texture unwrapping, normals, f_L and f_A (paper Fig. 2).
+
+The discriminator is not part of the model: it only exists during training (radar_cli.train).
+"""
+
+from __future__ import annotations
+
+import torch
+from torch import nn
+
+from radar_cli.checks import check_shape
+from radar_cli.model.albedo_net import AlbedoNet
+from radar_cli.model.config import ModelConfig
+from radar_cli.model.light_net import LightNet
+from radar_cli.model.outputs import Decomposition
+from radar_cli.model.shape_net import ShapeNet
+from radar_cli.render.texture import unwrap
+from radar_cli.sor.surface import surface_grid
+
+
+class RadarModel(nn.Module):
+    """The de-rendering function Phi of the paper: its three networks and the fixed geometry between them."""
+
+    def __init__(self, config: ModelConfig):
+        super().__init__()
+        config.validate()
+        self.config = config
+        r = config.render
+        self.shape_net = ShapeNet(r.image_size, config.geometry, config.shape_width, config.max_channels,
+                                  config.latent)
+        self.light_net = LightNet(min(r.tex_height, r.tex_width), r.env_height, config.light_width,
+                                  config.max_channels, config.latent, config.shininess_range,
+                                  config.spec_albedo_range, config.env_range)
+        self.albedo_net = AlbedoNet(config.albedo_depth, config.albedo_width, config.max_channels)
+
+    def unwrap_inputs(self, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
+                      image: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """The inputs of f_A and f_L: the frontal texture unwrapped with the given shape and its normals.
+
+        Returns:
+            texture B x 3 x Ht x Wt (as the image, tone-mapped), normals B x 3 x Ht x Wt (camera space).
+        """
+        c = self.config
+        size = (c.render.tex_height, c.render.tex_width)
+        texture = unwrap(radius, height, pose, image, size, c.camera)
+        grid = surface_grid(radius, height, pose, size[0], size[1], c.camera)
+        return texture, grid.normals.permute(0, 3, 1, 2)  # B x 3 x Ht x Wt
+
+    def forward(self, image: torch.Tensor) -> Decomposition:
+        """De-render a batch.
+
+        Args:
+            image: B x 3 x H x W tone-mapped RGB in [0, 1], H = W = config.render.image_size.
+
+        Returns:
+            Decomposition in physical units.
+        """
+        size = self.config.render.image_size
+        check_shape(image, f"B 3 {size} {size}", "image")
+        radius, height, pose = self.shape_net(image)
+        geo = (radius, height, pose)
+        if self.config.detach_shape_for_texture:
+            geo = tuple(t.detach() for t in geo)
+        texture, normals = self.unwrap_inputs(*geo, image)
+        env, alpha, rho = self.light_net(texture, normals)
+        albedo = self.albedo_net(texture)
+        return Decomposition(radius, height, pose, albedo, env, alpha, rho)

@@ -1,0 +1,168 @@
+"""Checkpoints: one safetensors file per save holding the model, D and both optimizers' tensors, with the run
+config, the step and the optimizers' settings as JSON metadata, so inference needs only the checkpoint.
+
+    RUN_DIR/checkpoints/step_0001000.safetensors   written atomically; the last K are kept
+
+Exported weights (`export_weights`) are the same format with only the model's tensors. Loading never
+unpickles anything; a corrupt file or one that does not fit the configuration raises CheckpointError.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import torch
+from safetensors import SafetensorError
+from safetensors.torch import load_file, save_file
+from torch import nn
+
+from radar_cli.errors import CheckpointError, ConfigError
+from radar_cli.fileio import atomic_path
+from radar_cli.model.config import RunConfig, run_config_from_dict, to_dict
+from radar_cli.model.radar import RadarModel
+
+FORMAT = "radar-checkpoint-1"
+CHECKPOINT_DIR = "checkpoints"
+_NAME_RE = re.compile(r"^step_(\d{7,})\.safetensors$")
+
+
+@dataclass
+class TrainState:
+    """Everything a run needs to continue exactly: the step to run next and the modules it updates."""
+
+    step: int
+    model: nn.Module
+    disc: nn.Module
+    opt_model: torch.optim.Optimizer
+    opt_disc: torch.optim.Optimizer
+
+
+def _optimizer_tensors(opt: torch.optim.Optimizer, prefix: str) -> tuple[dict[str, torch.Tensor], str]:
+    """Flatten an optimizer state_dict into named tensors plus JSON for its param groups."""
+    sd = opt.state_dict()
+    tensors = {}
+    for pid, state in sd["state"].items():
+        for name, value in state.items():
+            t = value if isinstance(value, torch.Tensor) else torch.tensor(value)
+            tensors[f"{prefix}.{pid}.{name}"] = t.detach().cpu().contiguous()
+    return tensors, json.dumps(sd["param_groups"])
+
+
+def _restore_optimizer(opt: torch.optim.Optimizer, tensors: dict[str, torch.Tensor], groups: str,
+                       prefix: str) -> None:
+    state: dict[int, dict[str, torch.Tensor]] = {}
+    for key, value in tensors.items():
+        if key.startswith(prefix + "."):
+            _, pid, name = key.split(".", 2)
+            state.setdefault(int(pid), {})[name] = value
+    opt.load_state_dict({"state": state, "param_groups": json.loads(groups)})
+
+
+def _module_tensors(module: nn.Module, prefix: str) -> dict[str, torch.Tensor]:
+    return {f"{prefix}.{k}": v.detach().cpu().contiguous() for k, v in module.state_dict().items()}
+
+
+def _load_module(module: nn.Module, tensors: dict[str, torch.Tensor], prefix: str, path: Path) -> None:
+    sub = {k[len(prefix) + 1 :]: v for k, v in tensors.items() if k.startswith(prefix + ".")}
+    try:
+        module.load_state_dict(sub, strict=True)
+    except RuntimeError as e:
+        first = str(e).strip().splitlines()
+        raise CheckpointError(f"{path}: {prefix} weights do not fit the configuration ({' '.join(first)[:300]})") from None
+
+
+def save_checkpoint(run_dir: str | Path, config: RunConfig, state: TrainState, keep: int) -> Path:
+    """Write RUN_DIR/checkpoints/step_<step>.safetensors atomically and delete all but the newest `keep`."""
+    tensors = _module_tensors(state.model, "model") | _module_tensors(state.disc, "disc")
+    opt_m, groups_m = _optimizer_tensors(state.opt_model, "opt_model")
+    opt_d, groups_d = _optimizer_tensors(state.opt_disc, "opt_disc")
+    meta = {"format": FORMAT, "config": json.dumps(to_dict(config)), "step": str(state.step),
+            "opt_model_groups": groups_m, "opt_disc_groups": groups_d}
+    path = Path(run_dir) / CHECKPOINT_DIR / f"step_{state.step:07d}.safetensors"
+    with atomic_path(path) as tmp:
+        save_file(tensors | opt_m | opt_d, str(tmp), metadata=meta)
+    for old in list_checkpoints(run_dir)[:-keep]:
+        old.unlink(missing_ok=True)
+    return path
+
+
+def list_checkpoints(run_dir: str | Path) -> list[Path]:
+    """Checkpoints of a run, oldest first."""
+    folder = Path(run_dir) / CHECKPOINT_DIR
+    if not folder.is_dir():
+        return []
+    found = [p for p in folder.iterdir() if _NAME_RE.match(p.name)]
+    return sorted(found, key=lambda p: int(_NAME_RE.match(p.name).group(1)))  # type: ignore[union-attr]
+
+
+def read_checkpoint(path: str | Path) -> tuple[dict[str, torch.Tensor], dict[str, str], RunConfig]:
+    """Tensors, metadata and config of a checkpoint or exported weights file, validated.
+
+    Raises:
+        CheckpointError: missing, truncated or corrupt file, foreign format, or an invalid stored config.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise CheckpointError(f"{path}: no such checkpoint")
+    try:
+        from safetensors import safe_open
+
+        with safe_open(str(path), framework="pt") as f:
+            meta = f.metadata() or {}
+        tensors = load_file(str(path))
+    except (SafetensorError, OSError, ValueError, RuntimeError) as e:
+        raise CheckpointError(f"{path}: corrupt or not a safetensors checkpoint ({e})") from None
+    if meta.get("format") != FORMAT:
+        raise CheckpointError(f"{path}: not a radar checkpoint (format {meta.get('format')!r}, expected {FORMAT})")
+    try:
+        config = run_config_from_dict(json.loads(meta["config"]))
+    except (KeyError, ValueError, ConfigError) as e:
+        raise CheckpointError(f"{path}: stored config is invalid ({e})") from None
+    return tensors, meta, config
+
+
+def restore(path: str | Path, config: RunConfig, state: TrainState) -> int:
+    """Load a checkpoint into `state` for `--resume`; returns the step to run next.
+
+    Raises:
+        CheckpointError: if the checkpoint is corrupt, or its model/loss config differs from `config`.
+    """
+    tensors, meta, stored = read_checkpoint(path)
+    for part in ("model", "loss"):
+        if to_dict(getattr(stored, part)) != to_dict(getattr(config, part)):
+            raise CheckpointError(f"{path}: its [{part}] config differs from the one given; resume with the same "
+                                  "config or start a new run folder")
+    _load_module(state.model, tensors, "model", Path(path))
+    _load_module(state.disc, tensors, "disc", Path(path))
+    try:
+        _restore_optimizer(state.opt_model, tensors, meta["opt_model_groups"], "opt_model")
+        _restore_optimizer(state.opt_disc, tensors, meta["opt_disc_groups"], "opt_disc")
+        state.step = int(meta["step"])
+    except (KeyError, ValueError) as e:
+        raise CheckpointError(f"{path}: optimizer state is missing or does not fit ({e})") from None
+    return state.step
+
+
+def export_weights(checkpoint: str | Path, out: str | Path) -> Path:
+    """Write only the model's weights and its config (safetensors metadata) from a checkpoint, atomically."""
+    tensors, meta, config = read_checkpoint(checkpoint)
+    model = {k: v for k, v in tensors.items() if k.startswith("model.")}
+    with atomic_path(out) as tmp:
+        save_file(model, str(tmp), metadata={"format": FORMAT, "config": json.dumps(to_dict(config)),
+                                             "step": meta.get("step", "0")})
+    return Path(out)
+
+
+def load_model(path: str | Path, device: str | torch.device = "cpu") -> tuple[RadarModel, RunConfig]:
+    """A RadarModel in eval mode from a checkpoint or exported weights file, with the config it was trained with.
+
+    Raises:
+        CheckpointError: corrupt file or weights that do not fit the stored config.
+    """
+    tensors, _, config = read_checkpoint(path)
+    model = RadarModel(config.model)
+    _load_module(model, tensors, "model", Path(path))
+    return model.to(device).eval(), config

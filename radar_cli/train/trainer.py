@@ -1,0 +1,193 @@
+"""The training loop of `radar train`, as plain functions: build the state, run steps, log, checkpoint, resume.
+
+Determinism: the model is initialised from `train.seed`; the batch of step s depends only on (seed, s) (see
+StepBatchSampler) and the global RNG is reseeded from (seed, s, rank) before every step (it draws the SAD
+patches), so a resumed run reproduces an uninterrupted one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import torch
+
+from radar_cli.errors import RadarError
+from radar_cli.model.config import RunConfig
+from radar_cli.model.discriminator import PatchDiscriminator
+from radar_cli.model.losses import sad_discriminator_loss
+from radar_cli.model.radar import RadarModel
+from radar_cli.train import distributed as D
+from radar_cli.train.checkpoint import TrainState, list_checkpoints, restore, save_checkpoint
+from radar_cli.train.data import StepBatchSampler, VaseDataset, make_loader, target_batch, to_batch
+from radar_cli.train.logging import RunLogger
+from radar_cli.train.step import Batch, generator_losses
+
+
+class DivergedError(RadarError):
+    """A loss or gradient became NaN or Inf; the run stopped before applying the bad update."""
+
+
+@dataclass(frozen=True)
+class TrainSummary:
+    """What a finished run reports.
+
+    Attributes:
+        run_dir: the run folder. start, end: first step run and the step count reached.
+        losses: the last step's loss terms. history: every step's terms (this process's batch share).
+        checkpoint: the last checkpoint written. seconds: wall time of the loop. sec_per_step: its mean.
+        state: the trained modules and optimizers.
+    """
+
+    run_dir: Path
+    start: int
+    end: int
+    losses: dict[str, float]
+    history: list[dict[str, float]]
+    checkpoint: Path | None
+    seconds: float
+    sec_per_step: float
+    state: TrainState = dataclasses.field(repr=False)
+
+
+def build_state(config: RunConfig, device: torch.device) -> TrainState:
+    """Model, discriminator and their Adam optimizers, initialised from the seed."""
+    torch.manual_seed(config.train.seed)
+    model = RadarModel(config.model).to(device)
+    m = config.model
+    disc = PatchDiscriminator(config.loss.sad_patch, m.disc_width, m.max_channels).to(device)
+    t = config.train
+    betas = (t.beta1, t.beta2)
+    return TrainState(0, model, disc, torch.optim.Adam(model.parameters(), t.lr, betas),
+                      torch.optim.Adam(disc.parameters(), t.lr, betas))
+
+
+def uses_sad(config: RunConfig) -> bool:
+    return not config.loss.no_sad and not config.loss.supervised
+
+
+def _finite_or_stop(value: torch.Tensor, what: str, step: int, info: D.DistInfo, run_dir: Path) -> None:
+    if D.all_finite(value, info):
+        return
+    ckpts = list_checkpoints(run_dir)
+    last = f"last good checkpoint: {ckpts[-1]}" if ckpts else "no checkpoint was written yet"
+    raise DivergedError(f"step {step}: {what} is NaN or Inf; stopped before the update ({last})")
+
+
+def train_step(state: TrainState, model: torch.nn.Module, disc: torch.nn.Module, batch: Batch, config: RunConfig,
+               info: D.DistInfo, run_dir: Path):
+    """One optimisation step of the model and, with L_SAD, of D. `model`/`disc` may be DDP wrappers of
+    state.model/state.disc. Returns (loss terms as floats, prediction, rendered) of this rank's batch."""
+    step = state.step
+    pred = model(batch.image)
+    _finite_or_stop(torch.stack([t.sum() for t in pred.as_tuple()]), "a network output", step, info, run_dir)
+    bare_disc = D.unwrap(disc)
+    terms, rendered = generator_losses(pred, batch, config, bare_disc if uses_sad(config) else None)
+    _finite_or_stop(terms["total"], "the loss", step, info, run_dir)
+    state.opt_model.zero_grad(set_to_none=True)
+    terms["total"].backward()
+    norm = torch.nn.utils.clip_grad_norm_(state.model.parameters(), float("inf"))
+    _finite_or_stop(norm, "the gradient", step, info, run_dir)
+    state.opt_model.step()
+    if rendered.sad_real is not None and rendered.sad_fake is not None:
+        d_loss = sad_discriminator_loss(disc, rendered.sad_real, rendered.sad_fake)
+        _finite_or_stop(d_loss, "the discriminator loss", step, info, run_dir)
+        state.opt_disc.zero_grad(set_to_none=True)
+        d_loss.backward()
+        state.opt_disc.step()
+        terms["disc"] = d_loss
+    state.step = step + 1
+    return {k: float(v.detach()) for k, v in terms.items()}, pred.detach(), rendered
+
+
+def _resume(run_dir: Path, config: RunConfig, state: TrainState) -> int:
+    ckpts = list_checkpoints(run_dir)
+    if not ckpts:
+        raise RadarError(f"{run_dir}: --resume given but there is no checkpoint in {run_dir / 'checkpoints'}")
+    return restore(ckpts[-1], config, state)
+
+
+def apply_overrides(config: RunConfig, iterations: int | None, overfit: int | None) -> RunConfig:
+    """The config with --iterations replaced and, for --overfit N, the batch size limited to N."""
+    train = config.train
+    if iterations is not None:
+        train = dataclasses.replace(train, iterations=iterations)
+    if overfit is not None:
+        train = dataclasses.replace(train, batch_size=min(train.batch_size, overfit))
+    return dataclasses.replace(config, train=train).validate()
+
+
+def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: bool = False,
+          device: str | None = None, overfit: int | None = None, iterations: int | None = None,
+          progress: bool = True) -> TrainSummary:
+    """Train RADAR on DATA/train and write checkpoints, metrics and images to run_dir.
+
+    Args:
+        config: the run's configuration (pipelines/*.toml).
+        data_dir: dataset root holding train/<id>/image.png + mask.png.
+        run_dir: output folder (created).
+        resume: continue from the newest checkpoint in run_dir.
+        device: "auto", "cpu" or "cuda" (overrides config.train.device).
+        overfit: train on the first N samples only (a wiring test).
+        iterations: total steps (overrides config.train.iterations).
+        progress: show the progress bar.
+
+    Returns:
+        TrainSummary.
+
+    Raises:
+        DivergedError: NaN/Inf in an output, loss or gradient (the step number and last checkpoint are named).
+        CheckpointError, InputError, ConfigError: unusable checkpoint, data or config.
+    """
+    config = apply_overrides(config, iterations, overfit)
+    info = D.setup(device or config.train.device)
+    if config.train.threads > 0:
+        torch.set_num_threads(config.train.threads)
+    run_dir = Path(run_dir)
+    run_dir.mkdir(parents=True, exist_ok=True)
+    try:
+        return _run(config, Path(data_dir), run_dir, resume, overfit, info, progress)
+    finally:
+        D.teardown(info)
+
+
+def _run(config: RunConfig, data_dir: Path, run_dir: Path, resume: bool, overfit: int | None,
+         info: D.DistInfo, progress: bool) -> TrainSummary:
+    t = config.train
+    dataset = VaseDataset(data_dir, "train", config.model.render.image_size, limit=overfit)
+    if config.loss.supervised:
+        dataset.load_targets()
+    state = build_state(config, info.device)
+    start = _resume(run_dir, config, state) if resume else 0
+    model, disc = D.wrap(state.model, info), D.wrap(state.disc, info)
+    sampler = StepBatchSampler(len(dataset), t.batch_size, t.seed, start, t.iterations, info.rank, info.world)
+    logger = RunLogger(run_dir, start, t.iterations, enabled=info.is_main, bar=progress)
+    history: list[dict[str, float]] = []
+    ckpt, t0, terms = None, time.perf_counter(), {}
+    try:
+        for step, items in enumerate(make_loader(dataset, sampler), start=start):
+            torch.manual_seed(t.seed * 1_000_003 + step * info.world + info.rank)
+            target = target_batch(dataset, items["index"], config, info.device) if config.loss.supervised else None
+            batch = to_batch(items, info.device, target)
+            tic = time.perf_counter()
+            terms, pred, rendered = train_step(state, model, disc, batch, config, info, run_dir)
+            history.append(terms)
+            done = state.step
+            logged = done % t.log_every == 0 or done == t.iterations
+            values = dict(D.mean_across(terms, info)) if logged else None
+            if values is not None:
+                values["sec_per_step"] = time.perf_counter() - tic
+            logger.step(step, values)
+            if done % t.image_every == 0 or done == t.iterations:
+                logger.grid(done, batch, pred, rendered, config.model.render.gamma)
+            if done % t.checkpoint_every == 0 or done == t.iterations:
+                if info.is_main:
+                    ckpt = save_checkpoint(run_dir, config, state, t.keep_checkpoints)
+                D.barrier(info)
+    finally:
+        logger.close()
+    seconds = time.perf_counter() - t0
+    n = max(1, len(history))
+    return TrainSummary(run_dir, start, state.step, terms, history, ckpt, seconds, seconds / n, state)

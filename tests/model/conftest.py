@@ -1,0 +1,33 @@
+"""Fixtures for model tests: a tiny RunConfig (32 px images, 32 x 32 textures) so every network runs in ms."""
+
+from __future__ import annotations
+
+import pytest
+import torch
+
+from radar_cli.config import GeometryConfig, RenderConfig
+from radar_cli.train.distributed import torch_threads
+from radar_cli.model.config import LossConfig, ModelConfig, RunConfig, TrainConfig
+
+
+def tiny_config(**loss) -> RunConfig:
+    """A RunConfig with the paper's structure at toy sizes."""
+    render = RenderConfig(image_size=32, tex_height=32, tex_width=32, env_height=4, env_width=12,
+                          shading_height=8, shading_width=8)
+    model = ModelConfig(render=render, geometry=GeometryConfig(n_rows=16), shape_width=8, light_width=8,
+                        albedo_width=8, disc_width=8, max_channels=32, latent=16, albedo_depth=3)
+    train = TrainConfig(batch_size=4, iterations=4, checkpoint_every=2, keep_checkpoints=2, image_every=2,
+                        log_every=1, device="cpu")
+    return RunConfig(name="tiny", model=model, loss=LossConfig(sad_patch=8, **loss), train=train).validate()
+
+
+@pytest.fixture
+def tiny() -> RunConfig:
+    return tiny_config()
+
+
+@pytest.fixture(autouse=True)
+def one_thread():
+    """One torch thread: on the shared 2-core machine two OpenMP threads oversubscribe and run ~20x slower."""
+    with torch_threads(1):
+        yield

@@ -1,0 +1,66 @@
+"""`radar train` through the CLI group (exit codes, files), the benchmark, and the logging helpers."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from click.testing import CliRunner
+
+from radar_cli.cli import cli
+from radar_cli.train.benchmark import bench_train
+from radar_cli.train.checkpoint import list_checkpoints, load_model
+from radar_cli.train.logging import loss_curve
+
+from .conftest import tiny_config
+
+PRESET = Path(__file__).resolve().parents[2] / "pipelines" / "syn_vases_cpu.toml"
+
+
+def test_train_command_runs_the_cpu_preset(vases64, tmp_path):
+    run = tmp_path / "run"
+    result = CliRunner().invoke(cli, ["train", "--config", str(PRESET), "--data", str(vases64), "--out", str(run),
+                                      "--overfit", "4", "--iterations", "2", "--device", "cpu"])
+    assert result.exit_code == 0, result.output
+    assert "trained steps 0..2" in result.output and "final losses:" in result.output
+    ckpt = list_checkpoints(run)[-1]
+    model, config = load_model(ckpt)
+    assert config.name == "syn_vases_cpu" and config.train.iterations == 2 and config.train.batch_size == 4
+    assert (run / "images" / "step_0000002.png").is_file() and (run / "loss_curve.png").is_file()
+    resumed = CliRunner().invoke(cli, ["train", "--config", str(PRESET), "--data", str(vases64), "--out", str(run),
+                                       "--overfit", "4", "--iterations", "3", "--resume"])
+    assert resumed.exit_code == 0, resumed.output
+    assert "trained steps 2..3" in resumed.output
+
+
+def test_train_command_errors_are_one_line(vases64, tmp_path):
+    runner = CliRunner()
+    missing = runner.invoke(cli, ["train", "--config", str(tmp_path / "nope.toml"), "--data", str(vases64),
+                                  "--out", str(tmp_path / "r")])
+    assert missing.exit_code == 2 and "Error:" in missing.output and "nope.toml" in missing.output
+    empty = tmp_path / "empty"
+    (empty / "train").mkdir(parents=True)
+    no_data = runner.invoke(cli, ["train", "--config", str(PRESET), "--data", str(empty), "--out",
+                                  str(tmp_path / "r")])
+    assert no_data.exit_code == 2 and "no samples" in no_data.output
+    bad = tmp_path / "bad.safetensors"
+    run = tmp_path / "r2"
+    (run / "checkpoints").mkdir(parents=True)
+    bad.write_bytes(b"junk")
+    (run / "checkpoints" / "step_0000005.safetensors").write_bytes(b"junk" * 10)
+    corrupt = runner.invoke(cli, ["train", "--config", str(PRESET), "--data", str(vases64), "--out", str(run),
+                                  "--resume", "--iterations", "6"])
+    assert corrupt.exit_code == 2 and "corrupt" in corrupt.output
+
+
+def test_bench_train_reports_speed_and_memory():
+    out = bench_train(tiny_config(), steps=2, warmup=1, device="cpu", threads=1)
+    assert out["sec_per_step"] > 0 and out["peak_memory_mb"] > 0 and out["batch_size"] == 4
+
+
+def test_loss_curve_draws_every_term():
+    records = [{"step": s, "total": 1.0 / (s + 1), "sil": 0.5, "sec_per_step": 0.1} for s in range(20)]
+    image = loss_curve(records)
+    assert image.shape == (500, 900, 3) and image.dtype == np.uint8
+    assert (image != 255).any(axis=2).sum() > 500  # lines and labels were drawn
+    assert loss_curve([]).shape == (500, 900, 3)

@@ -1,0 +1,63 @@
+"""DistributedDataParallel: 2 CPU processes on gloo under torchrun end a few steps with identical weights."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import torch
+from safetensors.torch import load_file
+
+from radar_cli.train.data import StepBatchSampler
+from radar_cli.train.trainer import build_state
+
+from .conftest import tiny_config
+
+REPO = Path(__file__).resolve().parents[2]
+
+SCRIPT = textwrap.dedent('''
+    import os, sys
+    import torch
+    from safetensors.torch import save_file
+    sys.path.insert(0, sys.argv[3])
+    from conftest import tiny_config
+    from radar_cli.train.trainer import train
+
+    torch.set_num_threads(1)
+    summary = train(tiny_config(iterations=3), sys.argv[1], sys.argv[2], progress=False)
+    rank = os.environ["RANK"]
+    state = {k: v.contiguous() for k, v in summary.state.model.state_dict().items()}
+    state.update({"disc." + k: v.contiguous() for k, v in summary.state.disc.state_dict().items()})
+    save_file(state, os.path.join(sys.argv[2], f"rank{rank}.safetensors"))
+''')
+
+
+def test_sampler_splits_the_global_batch_across_ranks():
+    whole = list(StepBatchSampler(10, 4, seed=3, start=0, end=5))
+    ranks = [list(StepBatchSampler(10, 4, seed=3, start=0, end=5, rank=r, world=2)) for r in range(2)]
+    for step in range(5):
+        assert sorted(ranks[0][step] + ranks[1][step]) == sorted(whole[step])
+    assert list(StepBatchSampler(10, 4, seed=3, start=2, end=5)) == whole[2:]
+    epoch0 = [i for b in whole[:2] for i in b] + whole[2][:2]
+    assert sorted(epoch0) == list(range(10))  # every sample once per epoch
+
+
+def test_ddp_two_gloo_processes_end_with_identical_weights(vases32, tmp_path):
+    script = tmp_path / "ddp_train.py"
+    script.write_text(SCRIPT)
+    run = tmp_path / "run"
+    env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=str(REPO))
+    cmd = [sys.executable, "-m", "torch.distributed.run", "--standalone", "--nproc_per_node=2", str(script),
+           str(vases32), str(run), str(Path(__file__).parent)]
+    done = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-3000:]
+    a, b = load_file(str(run / "rank0.safetensors")), load_file(str(run / "rank1.safetensors"))
+    assert a.keys() == b.keys()
+    for k in a:
+        assert torch.equal(a[k], b[k]), k
+    init = build_state(tiny_config(), torch.device("cpu")).model.state_dict()
+    assert any(not torch.equal(init[k], a["" + k]) for k in init)  # the ranks trained, in step
+    assert len(list((run / "checkpoints").iterdir())) == 2  # only rank 0 writes checkpoints

@@ -1,0 +1,87 @@
+"""The training loop: the loss goes down, resume reproduces an uninterrupted run, NaN stops cleanly, overfit."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+import torch
+
+from radar_cli.errors import RadarError
+from radar_cli.train import trainer
+from radar_cli.train.checkpoint import list_checkpoints, load_model
+from radar_cli.train.trainer import DivergedError, train
+
+from .conftest import tiny_config
+
+
+def test_few_steps_lower_the_loss(vases32, tmp_path):
+    config = tiny_config(lr=2e-3, batch_size=8, iterations=16, checkpoint_every=100, image_every=8)
+    summary = train(config, vases32, tmp_path / "run", progress=False)
+    totals = [h["total"] for h in summary.history]
+    assert len(totals) == 16 and all(map(torch.isfinite, torch.tensor(totals)))
+    assert sum(totals[-3:]) / 3 < 0.8 * sum(totals[:3]) / 3
+    assert summary.checkpoint is not None and summary.checkpoint.name == "step_0000016.safetensors"
+
+
+def test_outputs_of_a_run(vases32, tmp_path):
+    run = tmp_path / "run"
+    train(tiny_config(iterations=4), vases32, run, progress=True)
+    records = [json.loads(line) for line in (run / "metrics.jsonl").read_text().splitlines()]
+    assert [r["step"] for r in records] == [0, 1, 2, 3]
+    assert {"total", "sil", "im", "alb", "diff", "sad", "disc", "sec_per_step"} <= set(records[0])
+    assert sorted(p.name for p in (run / "images").iterdir()) == ["step_0000002.png", "step_0000004.png"]
+    assert (run / "loss_curve.png").stat().st_size > 1000
+    assert [p.name for p in list_checkpoints(run)] == ["step_0000002.safetensors", "step_0000004.safetensors"]
+
+
+def test_resume_continues_exactly(vases32, tmp_path):
+    full = train(tiny_config(iterations=6, checkpoint_every=3), vases32, tmp_path / "a", progress=False)
+    train(tiny_config(iterations=3, checkpoint_every=3), vases32, tmp_path / "b", progress=False)
+    resumed = train(tiny_config(iterations=6, checkpoint_every=3), vases32, tmp_path / "b", resume=True,
+                    progress=False)
+    assert resumed.start == 3 and resumed.end == 6
+    for a, b in zip(full.history[3:], resumed.history):
+        assert a.keys() == b.keys()
+        for k in a:
+            assert a[k] == pytest.approx(b[k], rel=1e-5, abs=1e-7), k
+    model_a, _ = load_model(list_checkpoints(tmp_path / "a")[-1])
+    model_b, _ = load_model(list_checkpoints(tmp_path / "b")[-1])
+    for (name, pa), pb in zip(model_a.state_dict().items(), model_b.state_dict().values()):
+        assert torch.allclose(pa, pb, atol=1e-6), name
+    steps = [json.loads(line)["step"] for line in (tmp_path / "b" / "metrics.jsonl").read_text().splitlines()]
+    assert steps == list(range(6))
+
+
+def test_resume_without_checkpoint_is_an_error(vases32, tmp_path):
+    with pytest.raises(RadarError, match="no checkpoint"):
+        train(tiny_config(), vases32, tmp_path / "empty", resume=True, progress=False)
+
+
+def test_nan_stops_with_step_and_keeps_last_good_checkpoint(vases32, tmp_path, monkeypatch):
+    real = trainer.generator_losses
+    calls = {"n": 0}
+
+    def poisoned(pred, batch, config, disc):
+        terms, rendered = real(pred, batch, config, disc)
+        calls["n"] += 1
+        if calls["n"] == 3:  # step index 2
+            terms["total"] = terms["total"] * float("nan")
+        return terms, rendered
+
+    monkeypatch.setattr(trainer, "generator_losses", poisoned)
+    run = tmp_path / "run"
+    with pytest.raises(DivergedError, match=r"step 2: the loss is NaN or Inf.*step_0000002\.safetensors"):
+        train(tiny_config(iterations=6), vases32, run, progress=False)
+    model, _ = load_model(list_checkpoints(run)[-1])
+    assert all(torch.isfinite(p).all() for p in model.parameters())
+    assert (run / "loss_curve.png").is_file()
+
+
+@pytest.mark.slow
+def test_overfit_one_sample_drives_reconstruction_near_zero(vases32, tmp_path):
+    config = tiny_config(lr=2e-3, iterations=300, checkpoint_every=1000, image_every=1000)
+    summary = train(config, vases32, tmp_path / "run", overfit=1, progress=False)
+    first, last = summary.history[0], summary.history[-1]
+    assert last["im"] < 0.03 and last["im"] < 0.25 * first["im"]
+    assert last["sil"] < 0.7 * first["sil"]  # the soft silhouette's blur sets a floor at 32 px
