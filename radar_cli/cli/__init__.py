@@ -16,6 +16,7 @@ COMMANDS: list[tuple[str, str]] = [
     ("radar_cli.cli.fetch", "fetch"),
     ("radar_cli.cli.masks", "masks"),
     ("radar_cli.cli.synth", "synth"),
+    ("radar_cli.cli.train", "train"),
     ("radar_cli.cli.derender", "derender"),
     ("radar_cli.cli.relight", "relight"),
     ("radar_cli.cli.eval", "eval"),
