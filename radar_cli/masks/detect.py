@@ -31,12 +31,15 @@ class Detection:
         box: (x0, y0, x1, y1) in the ORIGINAL photo's pixels, half-open.
         score: mean foreground evidence inside the mask, in [0, 1] (higher = more clearly not backdrop).
         scale: detection pixels per original pixel.
+        sure: h x w bool, the pixels of `mask` with direct evidence (not just enclosed by the object's outline:
+            a hole filled there may be backdrop seen through a handle), or None if all of `mask` is sure.
     """
 
     mask: np.ndarray
     box: tuple[float, float, float, float]
     score: float
     scale: float
+    sure: np.ndarray | None = None
 
 
 def downscale(image: np.ndarray, long_side: int = WORK_SIDE) -> tuple[np.ndarray, float]:
@@ -235,7 +238,8 @@ def detect(image: np.ndarray, threshold: float = 0.5) -> list[Detection]:
     """
     small, scale = downscale(image)
     evidence = foreground_evidence(small)
-    mask = _clean(evidence > threshold)
+    raw = evidence > threshold
+    mask = _clean(raw)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     if n <= 1:
         return []
@@ -248,5 +252,5 @@ def detect(image: np.ndarray, threshold: float = 0.5) -> list[Detection]:
         comp = np.isin(labels, [big[k] for k in members])
         ys, xs = np.nonzero(comp)
         box = (xs.min() / scale, ys.min() / scale, (xs.max() + 1) / scale, (ys.max() + 1) / scale)
-        found.append(Detection(comp, box, float(evidence[comp].mean()), scale))
+        found.append(Detection(comp, box, float(evidence[comp].mean()), scale, comp & raw))
     return sorted(found, key=lambda d: -int(d.mask.sum()))

@@ -113,8 +113,10 @@ def crop_detection(image: np.ndarray, found: Detection, settings: Settings) -> C
     fill_margin = 0.5 - (1.0 - 2.0 * settings.margin) / (2.0 * REFINE_PAD)
     window = crops.square_box(found.box, fill_margin)
     work_img = crops.cut(image, window, work_side)
-    rough = crops.warp_mask(found.mask, crops.crop_affine(window, work_side, found.scale), work_side)
-    mask, used_grabcut = refine(work_img, rough)
+    to_work = crops.crop_affine(window, work_side, found.scale)
+    rough = crops.warp_mask(found.mask, to_work, work_side)
+    sure = None if found.sure is None else crops.warp_mask(found.sure, to_work, work_side)
+    mask, used_grabcut = refine(work_img, rough, sure=sure)
     box = crops.mask_box(mask)
     if box is None:
         box, mask = crops.mask_box(rough) or (0, 0, work_side, work_side), rough

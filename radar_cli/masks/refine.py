@@ -25,12 +25,15 @@ def _disk(radius: int) -> np.ndarray:
     return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (d, d))
 
 
-def trimap(rough: np.ndarray) -> np.ndarray:
-    """GrabCut's 4-level mask from a rough bool mask: definite foreground deep inside, probable foreground and
-    probable background in bands either side of the outline, definite background beyond."""
+def trimap(rough: np.ndarray, sure: np.ndarray | None = None) -> np.ndarray:
+    """GrabCut's 4-level mask from a rough bool mask: definite foreground deep inside (and only where `sure`,
+    if given), probable foreground and probable background in bands either side of the outline, definite
+    background beyond."""
     m = rough.astype(np.uint8)
     size = np.sqrt(max(int(m.sum()), 1))
     inner = cv2.erode(m, _disk(round(INNER_BAND * size))) > 0
+    if sure is not None:
+        inner &= cv2.erode(sure.astype(np.uint8), _disk(1)) > 0
     outer = cv2.dilate(m, _disk(round(OUTER_BAND * size))) > 0
     tri = np.full(m.shape, cv2.GC_BGD, np.uint8)
     tri[outer] = cv2.GC_PR_BGD
@@ -89,12 +92,14 @@ def snap_edges(image: np.ndarray, mask: np.ndarray, band: int = 2, sigma: float 
     return out
 
 
-def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4) -> tuple[np.ndarray, bool]:
+def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4,
+           sure: np.ndarray | None = None) -> tuple[np.ndarray, bool]:
     """Refine a rough mask with GrabCut.
 
     Args:
         image: S x S x 3 uint8 RGB crop.
         rough: S x S bool rough mask (from the detector, warped into the crop).
+        sure: S x S bool, where the detector saw the object itself (not a filled hole); None = everywhere.
         iterations: GrabCut iterations.
 
     Returns:
@@ -108,7 +113,9 @@ def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4) -> tuple[n
     small = min(1.0, GRABCUT_SIDE / side)
     gc_img = cv2.resize(image, None, fx=small, fy=small, interpolation=cv2.INTER_AREA) if small < 1 else image
     gc_rough = cv2.resize(rough.astype(np.uint8), gc_img.shape[1::-1], interpolation=cv2.INTER_NEAREST) > 0
-    tri = trimap(gc_rough)
+    gc_sure = None if sure is None else cv2.resize(sure.astype(np.uint8), gc_img.shape[1::-1],
+                                                  interpolation=cv2.INTER_NEAREST) > 0
+    tri = trimap(gc_rough, gc_sure)
     if not (tri == cv2.GC_FGD).any() or not (tri == cv2.GC_BGD).any():
         return clean(rough, sigma), False
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
