@@ -32,16 +32,18 @@ from radar_cli.derender.predictor import Predictor
 @click.option("--batch-size", type=click.IntRange(1, 1024), default=8, show_default=True)
 @click.option("--workers", type=click.IntRange(0, 64), default=2, show_default=True,
               help="Threads reading and cropping images.")
+@click.option("--threads", type=click.IntRange(1, 256), default=1, show_default=True,
+              help="torch threads for the network (more helps only on an otherwise idle machine).")
 @click.option("--overwrite", is_flag=True, help="Redo objects whose folders are already complete.")
 @click.option("--contact-sheet", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Also write a contact sheet PNG (input, reconstruction, albedo, relit view per object).")
 def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks: Path | None, crop: str,
              device: str, views: int, view_size: int, envs: tuple[Path, ...], batch_size: int, workers: int,
-             overwrite: bool, contact_sheet: Path | None) -> None:
+             threads: int, overwrite: bool, contact_sheet: Path | None) -> None:
     """De-render INPUTS (image files, folders, prepared dataset folders) into --out."""
     predictor = Predictor.from_checkpoint(checkpoint, device)
     options = DerenderOptions(out=out, crop=crop, masks=masks, envs=envs, batch_size=batch_size,  # type: ignore[arg-type]
-                              workers=workers, overwrite=overwrite, export=ExportConfig(views, view_size))
+                              workers=workers, threads=threads, overwrite=overwrite, export=ExportConfig(views, view_size))
     summary = run_derender(list(inputs), predictor, options, say=lambda line: click.echo(line, err=True))
     if contact_sheet is not None and (summary.done or summary.skipped):
         click.echo(f"contact sheet: {write_contact_sheet(out, contact_sheet)}")

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from radar_cli.derender.batch import DerenderOptions, derender
+from radar_cli.derender.batch import DerenderOptions, derender, torch_threads
 from radar_cli.derender.export import ExportConfig
 from radar_cli.derender.predictor import Predictor
 from radar_cli.fileio import write_image
@@ -52,8 +52,8 @@ def _network_rate(predictor: Predictor, images: list[np.ndarray], batch_size: in
 
 
 def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_images: int = 32,
-                   n_export: int = 4, batch_size: int = 8, export: ExportConfig = ExportConfig(),
-                   predictor: Predictor | None = None) -> dict:
+                   n_export: int = 4, batch_size: int = 8, threads: int = 1,
+                   export: ExportConfig = ExportConfig(), predictor: Predictor | None = None) -> dict:
     """Measure de-rendering speed.
 
     Args:
@@ -62,6 +62,7 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         n_images: images pushed through the network alone.
         n_export: images de-rendered end to end (read, crop, network, all exports, report).
         batch_size: network batch size.
+        threads: torch intra-op threads.
         export: turntable and view settings of the full run.
         predictor: use this instead of loading `checkpoint` (tests).
 
@@ -72,11 +73,12 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
     predictor = predictor or Predictor.from_checkpoint(checkpoint, device)
     size = predictor.setup.image_size
     images = _photos(n_images, size)
-    net_wall, net_cpu = _network_rate(predictor, images, batch_size)
+    with torch_threads(threads):
+        net_wall, net_cpu = _network_rate(predictor, images, batch_size)
     with tempfile.TemporaryDirectory(prefix="radar-bench-") as tmp:
         for i, image in enumerate(_photos(n_export, size)):
             write_image(Path(tmp) / "in" / f"bench_{i:03d}.png", image)
-        options = DerenderOptions(out=Path(tmp) / "out", batch_size=batch_size, export=export)
+        options = DerenderOptions(out=Path(tmp) / "out", batch_size=batch_size, threads=threads, export=export)
         start = time.perf_counter()
         summary = derender([Path(tmp) / "in"], predictor, options, say=lambda line: None)
         full = time.perf_counter() - start
@@ -91,6 +93,6 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         "n_images": n_images,
         "n_export": n_export,
         "device": str(predictor.device),
-        "threads": torch.get_num_threads(),
+        "threads": threads,
         "model": predictor.version,
     }

@@ -20,7 +20,7 @@ from radar_cli.render.lighting import tone_map
 from radar_cli.render.texture import full_from_front
 from radar_cli.results import ALBEDO_FILE, ENV_MAP_FILE, MATERIAL_FILE
 
-EXPORT_SHADING_GRID = 32  # rows and columns (per frontal third) of the shading grid of whole-object renders
+EXPORT_SHADING_GRID = 32  # at most this many rows and columns (per frontal third) in whole-object renders' shading
 
 
 def roughness_from_shininess(alpha: float) -> float:
@@ -66,8 +66,8 @@ class ObjectState:
         """The state of a batch-of-one Decomposition; the frontal albedo is mirrored to 360 deg."""
         if dec.radius.shape[0] != 1:
             raise ValueError(f"expected a batch of one, got {dec.radius.shape[0]}")
-        export_render = dataclasses.replace(render, shading_height=EXPORT_SHADING_GRID,
-                                            shading_width=EXPORT_SHADING_GRID)
+        export_render = dataclasses.replace(render, shading_height=min(render.shading_height, EXPORT_SHADING_GRID),
+                                            shading_width=min(render.shading_width, EXPORT_SHADING_GRID))
         albedo = quantise(full_from_front(dec.albedo.float().clamp(0, 1)), render.gamma)
         return cls(dec.radius.float(), dec.height.float(), dec.pose.float(), albedo, dec.env.float(),
                    dec.alpha.float(), dec.rho.float(), export_render, camera)
