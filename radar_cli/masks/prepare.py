@@ -121,8 +121,9 @@ def process_source(out: Path, source: Source, settings: Settings, spec: Detector
         crops = process_photo(source.path, settings, _detector(spec))
     except InputError as e:
         record.update(status="failed", reason=str(e))
-    except (cv2.error, ValueError, MemoryError) as e:  # a decoder or OpenCV choking on odd data
-        record.update(status="failed", reason=f"{source.path}: {type(e).__name__}: {str(e).splitlines()[0]}")
+    except Exception as e:  # noqa: BLE001 - one odd photo (decoder, OpenCV, a bug) must not stop the batch
+        first = (str(e).splitlines() or [""])[0]
+        record.update(status="failed", reason=f"{source.path}: {type(e).__name__}: {first}")
     else:
         split = split_for(source.key)
         record["crops"] = [_write_crop(out, source, c, i, split) for i, c in enumerate(crops)]

@@ -94,3 +94,21 @@ def test_onnx_detector_without_runtime_says_how_to_install(tmp_path, monkeypatch
 
     with pytest.raises(InputError, match="onnxruntime"):
         OnnxDetector(tmp_path / "m.onnx")
+
+
+def test_a_crashing_photo_is_recorded_and_the_batch_goes_on(tmp_path, monkeypatch):
+    from radar_cli.masks import prepare as prep
+
+    for i in range(2):
+        Image.fromarray(_studio(i)).save(tmp_path / f"v{i}.png")
+    real = prep.process_photo
+
+    def flaky(path, *args, **kwargs):
+        if path.name == "v0.png":
+            raise IndexError("boom")
+        return real(path, *args, **kwargs)
+
+    monkeypatch.setattr(prep, "process_photo", flaky)
+    summary = prepare(tmp_path, tmp_path / "out", progress=False)
+    assert summary.failed == 1 and summary.photos == 2
+    assert "IndexError: boom" in (tmp_path / "out" / "failures.csv").read_text()
