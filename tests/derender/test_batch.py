@@ -26,7 +26,7 @@ EXPORT = ExportConfig(views=4, view_size=32)
 PNGS = ("input.png", "mask.png", "mask_front.png", "albedo.png", "texture.png", "normal.png", "diffuse.png",
         "specular.png", "env_map.png", "recon.png", "albedo_rendered.png", "normal_rendered.png",
         "material_sphere.png", "turntable.png", "relit_studio.png", "relit_sunset.png", "relit_overcast.png",
-        "relit_two_lights.png")
+        "relit_two_lights.png", "relit_gallery.png")
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +38,10 @@ def results(tmp_path_factory) -> Path:
     write_photo(root / "in" / "square.png", 1, (80, 80))
     write_photo(root / "in" / "wide.jpg", 2, (96, 144))
     predictor = Predictor(FakeModel(), SETUP, "fake-model", "cpu")
-    summary = derender([root / "in"], predictor, DerenderOptions(out=root / "out", export=EXPORT))
+    gallery_env = root / "gallery.hdr"  # a user environment map, any size: resampled to the model's
+    cv2.imwrite(str(gallery_env), np.ones((10, 20, 3), np.float32))
+    options = DerenderOptions(out=root / "out", envs=(gallery_env,), export=EXPORT)
+    summary = derender([root / "in"], predictor, options)
     assert summary.done == ["square", "wide"] and not summary.failures
     return root / "out"
 
@@ -93,7 +96,8 @@ def test_crop_box_recorded(results: Path) -> None:
 def test_gallery_and_summary(results: Path) -> None:
     page = (results / "index.html").read_text()
     assert "http" not in page  # no network needed
-    for src in ("square/recon.png", "wide/turntable.gif", "wide/relit_sunset.png", "square/mesh.glb"):
+    for src in ("square/recon.png", "wide/turntable.gif", "wide/relit_sunset.png", "wide/relit_gallery.png",
+                "square/mesh.glb"):
         assert f'"{src}"' in page and (results / src).is_file()
     rows = list(csv.DictReader((results / "summary.csv").open()))
     assert [r["object"] for r in rows] == ["square", "wide"] and float(rows[0]["alpha"]) > 0
