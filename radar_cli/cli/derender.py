@@ -42,8 +42,9 @@ def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks
              threads: int, overwrite: bool, contact_sheet: Path | None) -> None:
     """De-render INPUTS (image files, folders, prepared dataset folders) into --out."""
     predictor = Predictor.from_checkpoint(checkpoint, device)
-    options = DerenderOptions(out=out, crop=crop, masks=masks, envs=envs, batch_size=batch_size,  # type: ignore[arg-type]
-                              workers=workers, threads=threads, overwrite=overwrite, export=ExportConfig(views, view_size))
+    options = DerenderOptions(out=out, crop=crop, masks=masks, envs=envs,  # type: ignore[arg-type]
+                              batch_size=batch_size, workers=workers, threads=threads, overwrite=overwrite,
+                              export=ExportConfig(views, view_size))
     summary = run_derender(list(inputs), predictor, options, say=lambda line: click.echo(line, err=True))
     if contact_sheet is not None and (summary.done or summary.skipped):
         click.echo(f"contact sheet: {write_contact_sheet(out, contact_sheet)}")

@@ -72,13 +72,24 @@ def _read_float_image(path: Path) -> np.ndarray:
             raise InputError(f"{path}: not a readable .npy array ({e})") from None
     if suffix in (".hdr", ".exr"):
         os.environ.setdefault("OPENCV_IO_ENABLE_OPENEXR", "1")  # OpenCV reads EXR only when asked to
-        arr = cv2.imread(str(path), cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR)
+        try:
+            arr = cv2.imread(str(path), cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR)
+        except cv2.error as e:
+            raise InputError(f"{path}: not a readable {suffix} image ({e})") from None
         if arr is None:
-            raise InputError(f"{path}: not a readable {suffix} image")
+            hint = "" if suffix == ".hdr" or _has_openexr() else " (this OpenCV has no EXR support: use .hdr or .npy)"
+            raise InputError(f"{path}: not a readable {suffix} image{hint}")
         return np.asarray(arr, np.float32)
     from radar_cli.fileio import read_image
 
     return (read_image(path, "RGB").astype(np.float32) / 255.0) ** GAMMA
+
+
+def _has_openexr() -> bool:
+    """Whether the installed OpenCV was built with OpenEXR (the pip wheels of OpenCV 5 are not)."""
+    import cv2
+
+    return any("OpenEXR" in line and "YES" in line for line in cv2.getBuildInformation().splitlines())
 
 
 def load_environment(path: str | Path, height: int, width: int) -> np.ndarray:

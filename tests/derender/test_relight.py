@@ -95,6 +95,9 @@ def test_environment_files_agree(tmp_path: Path) -> None:
     np.testing.assert_allclose(from_png, env, atol=0.03 * env.max())
     with pytest.raises(InputError, match="unsupported"):
         load_environment(shutil.copy(tmp_path / "e.npy", tmp_path / "e.txt"), 8, 24)
+    (tmp_path / "bad.exr").write_bytes(b"v/1\x01 not really exr")
+    with pytest.raises(InputError, match="bad.exr: not a readable .exr"):
+        load_environment(tmp_path / "bad.exr", 8, 24)
 
 
 def test_builtins_are_normalised() -> None:
