@@ -92,7 +92,8 @@ def fit_backdrop(image: np.ndarray, band: np.ndarray, rounds: int = 3) -> tuple[
     sample[:: max(1, len(ys) // 4000)] = True  # a few thousand border pixels pin six coefficients down
     for _ in range(rounds):
         fit = keep & sample
-        coef, *_ = np.linalg.lstsq(a_all[fit], values[fit], rcond=None)  # 6 x C
+        a, b = a_all[fit].astype(np.float64), values[fit].astype(np.float64)
+        coef = np.linalg.solve(a.T @ a + 1e-6 * np.eye(6), a.T @ b)  # 6 x C (normal equations: 6 unknowns)
         resid = np.linalg.norm(values - a_all @ coef, axis=1)
         cut = max(3.0 * 1.4826 * np.median(resid[keep]), 6.0)
         keep = resid < cut
