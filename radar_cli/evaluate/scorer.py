@@ -16,7 +16,7 @@ from tqdm import tqdm
 from radar_cli.errors import InputError
 from radar_cli.evaluate import metrics
 from radar_cli.evaluate.loading import Prediction, Truth, load_prediction, load_truth
-from radar_cli.results import ResultPaths, list_results
+from radar_cli.results import list_results
 from radar_cli.synth import layout
 
 # (key, label, display factor): the columns of the paper's Table 2, in its order
