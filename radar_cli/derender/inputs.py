@@ -67,10 +67,19 @@ def _is_image(path: Path) -> bool:
 
 
 def _folder_items(folder: Path, masks: Path | None) -> list[InputItem]:
-    """Items (names not yet unique) of a prepared dataset (<split>/<id>/image.png) or every image under a folder."""
-    if is_dataset(folder):
-        found = sorted(folder.glob(f"*/*/{IMAGE_FILE}"))
-        return [InputItem(f"{p.parent.parent.name}_{p.parent.name}", p, is_crop=True) for p in found]
+    """Items (names not yet unique) of a folder: a prepared dataset (<split>/<id>/image.png), one split of it
+    (<id>/image.png), or else every image under it.
+
+    Dataset samples are named by id, so `radar eval` matches them to their ground truth; with several splits
+    the split is prefixed (<split>_<id>)."""
+    samples = sorted(folder.glob(f"*/*/{IMAGE_FILE}")) if is_dataset(folder) else []
+    if samples:
+        several = len({p.parent.parent.name for p in samples}) > 1
+        return [InputItem(f"{p.parent.parent.name}_{p.parent.name}" if several else p.parent.name, p, is_crop=True)
+                for p in samples]
+    samples = sorted(folder.glob(f"*/{IMAGE_FILE}"))
+    if samples:
+        return [InputItem(p.parent.name, p, is_crop=True) for p in samples]
     images = sorted(p for p in folder.rglob("*") if p.is_file() and _is_image(p))
     return [InputItem(p.stem, p, _mask_for(p, masks)) for p in images]
 

@@ -95,8 +95,10 @@ def write_input_view(folder: Path, state: ObjectState, size: int) -> None:
     write_image(folder / MASK_FILE, to_uint8(coverage[0].numpy()))
     _, front = render_front(hits, torch.ones_like(state.albedo[:, :1, :, : state.albedo.shape[-1] // 3]))
     write_image(folder / MASK_FRONT_FILE, to_uint8(front[0, 0].numpy()))
-    albedo, _ = render_texture(hits, tone_map(state.albedo, state.render.gamma), inside_dim=1.0, background=1.0)
-    write_image(folder / ALBEDO_RENDERED_FILE, chw_image(albedo))
+    # drawn as radar synth draws its ground truth (black off the hard silhouette), so radar eval compares like
+    # with like at the outline
+    albedo, _ = render_texture(hits, tone_map(state.albedo, state.render.gamma), inside_dim=1.0, background=0.0)
+    write_image(folder / ALBEDO_RENDERED_FILE, chw_image(albedo * hits.mask[:, None]))
     normals = torch.where(hits.mask[..., None], (hits.normal + 1) / 2, torch.zeros_like(hits.normal))
     write_image(folder / NORMAL_RENDERED_FILE, to_uint8(normals[0].numpy()))
     write_image(folder / RECON_FILE, view.draw(view.shading()))

@@ -23,7 +23,7 @@ def test_collect_files_folders_and_datasets(tmp_path: Path) -> None:
     write_sample(ref, vase_photo(3), np.ones((SIZE, SIZE), bool))
     items, failures = collect_inputs([tmp_path / "photos", tmp_path / "data", tmp_path / "photos" / "a.png",
                                       tmp_path / "missing.png"])
-    assert [i.name for i in items] == ["a", "a-2", "test_v1"]
+    assert [i.name for i in items] == ["a", "a-2", "v1"]  # dataset samples keep their id (radar eval)
     assert items[2].is_crop and not items[0].is_crop
     assert [f.source for f in failures] == [str(tmp_path / "missing.png")]
     assert "no such file" in failures[0].problem
@@ -35,6 +35,17 @@ def test_dataset_sample_used_whole(tmp_path: Path) -> None:
     (item,), _ = collect_inputs([tmp_path])
     prepared = prepare(item, SIZE)
     assert prepared.crop.to_list() == [0, 0, 128] and prepared.image.shape == (SIZE, SIZE, 3)
+
+
+def test_dataset_splits_and_split_folder(tmp_path: Path) -> None:
+    for split in ("train", "test"):
+        ref = sample_ref(tmp_path, split, "000000")
+        write_sample(ref, vase_photo(3), np.ones((SIZE, SIZE), bool))
+        (ref.folder / "albedo.png").write_bytes(b"ground truth, not an input")
+    items, failures = collect_inputs([tmp_path])
+    assert [i.name for i in items] == ["test_000000", "train_000000"] and not failures
+    (item,), _ = collect_inputs([tmp_path / "test"])  # one split given directly: only its image.png files
+    assert item.name == "000000" and item.is_crop
 
 
 def test_crop_none_pads_to_square(tmp_path: Path) -> None:
