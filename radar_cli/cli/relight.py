@@ -16,7 +16,10 @@ from radar_cli.derender.relight import relight as run_relight
 @click.option("--yaw", type=float, default=0.0, show_default=True, help="Spin about the object's axis (deg).")
 @click.option("--pitch", type=float, default=None, help="Camera elevation in degrees (default: predicted).")
 @click.option("--size", type=int, default=None, help="Image side in pixels (default: the input's).")
+@click.option("--absolute", is_flag=True,
+              help="Use the map's radiance as is (default: scaled to the exposure of the object's own lighting).")
 @click.option("--out", required=True, type=click.Path(dir_okay=False, path_type=Path), help="Image to write.")
-def relight(object_dir: Path, env: Path, yaw: float, pitch: float | None, size: int | None, out: Path) -> None:
+def relight(object_dir: Path, env: Path, yaw: float, pitch: float | None, size: int | None, absolute: bool,
+            out: Path) -> None:
     """Relight OBJECT_DIR (a folder written by `radar derender`) without the network."""
-    click.echo(f"wrote {run_relight(object_dir, env, out, yaw, pitch, size)}")
+    click.echo(f"wrote {run_relight(object_dir, env, out, yaw, pitch, size, match=not absolute)}")

@@ -33,13 +33,23 @@ def _lobe(dirs: np.ndarray, el_deg: float, az_deg: float, sharpness: float) -> n
     return np.exp(sharpness * (dirs @ xi - 1.0))
 
 
-def normalise(env: np.ndarray, target: float = TARGET_FRONT_IRRADIANCE) -> np.ndarray:
-    """Scale an He x We map so the diffuse factor of a surface facing the camera equals `target`."""
+def front_irradiance(env: np.ndarray) -> float:
+    """The diffuse factor an He x We map gives a surface facing the camera (its exposure)."""
     h, w = env.shape
     dirs, solid = env_directions(h, w)
     cos = (-dirs[:, 2]).clamp_min(0).numpy()  # normal (0, 0, -1) faces the camera
-    irradiance = float((env.reshape(-1) * solid.numpy() * cos).sum())
-    return (env * (target / max(irradiance, 1e-8))).astype(np.float32)
+    return float((env.reshape(-1) * solid.numpy() * cos).sum())
+
+
+def normalise(env: np.ndarray, target: float = TARGET_FRONT_IRRADIANCE) -> np.ndarray:
+    """Scale an He x We map so the diffuse factor of a surface facing the camera equals `target`."""
+    return (env * (target / max(front_irradiance(env), 1e-8))).astype(np.float32)
+
+
+def match_exposure(env: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Scale `env` to the exposure of `reference` (the object's own lighting), so a relit view changes the light's
+    direction and spread, not the overall brightness (HDR files come in arbitrary units)."""
+    return normalise(env, max(front_irradiance(reference), 1e-8))
 
 
 def builtin_environments(height: int, width: int) -> dict[str, np.ndarray]:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import torch
 
-from radar_cli.derender.environments import load_environment
+from radar_cli.derender.environments import load_environment, match_exposure
 from radar_cli.derender.renders import render_object
 from radar_cli.derender.state import read_record, read_state
 from radar_cli.errors import InputError
@@ -17,7 +17,7 @@ MAX_SIZE = 4096
 
 
 def relight(folder: str | Path, env_path: str | Path, out: str | Path, yaw_deg: float = 0.0,
-            pitch_deg: float | None = None, size: int | None = None) -> Path:
+            pitch_deg: float | None = None, size: int | None = None, match: bool = True) -> Path:
     """Render one object under another environment map.
 
     Args:
@@ -27,6 +27,7 @@ def relight(folder: str | Path, env_path: str | Path, out: str | Path, yaw_deg: 
         yaw_deg: spin about the object's axis.
         pitch_deg: camera elevation in degrees (default: the predicted pitch).
         size: image side in pixels (default: the network's input size recorded in material.json).
+        match: scale the map to the exposure of the object's own lighting (False: use its radiance as is).
 
     Returns:
         The path written.
@@ -36,6 +37,8 @@ def relight(folder: str | Path, env_path: str | Path, out: str | Path, yaw_deg: 
     if not 8 <= size <= MAX_SIZE:
         raise InputError(f"--size must lie in [8, {MAX_SIZE}], got {size}")
     env = load_environment(env_path, state.env.shape[1], state.env.shape[2])
+    if match:
+        env = match_exposure(env, state.env[0].numpy())
     image = render_object(state, size, yaw_deg, pitch_deg, env=torch.from_numpy(env)[None])
     write_image(out, image)
     return Path(out)

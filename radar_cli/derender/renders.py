@@ -13,6 +13,7 @@ import torch.nn.functional as F
 from PIL import Image
 
 from radar_cli.config import CameraConfig
+from radar_cli.derender.environments import match_exposure
 from radar_cli.derender.maps import chw_image
 from radar_cli.derender.state import ObjectState
 from radar_cli.fileio import atomic_path, to_uint8, write_image
@@ -156,9 +157,11 @@ def relit_file(name: str) -> str:
 
 
 def write_relit(folder: Path, view: ViewRenderer, envs: dict[str, np.ndarray]) -> None:
-    """relit_<name>.png for every environment (He x We maps, camera frame), from the input's view."""
+    """relit_<name>.png for every environment (He x We maps, camera frame), from the input's view, each at the
+    exposure of the object's own lighting."""
+    own = view.state.env[0].numpy()
     for name, env in envs.items():
-        shading = view.shading(torch.from_numpy(np.asarray(env, np.float32))[None])
+        shading = view.shading(torch.from_numpy(match_exposure(np.asarray(env, np.float32), own))[None])
         write_image(folder / relit_file(name), view.draw(shading))
 
 

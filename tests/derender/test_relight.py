@@ -115,3 +115,13 @@ def test_contact_sheet(obj: Path, tmp_path: Path) -> None:
         assert im.size[1] > 100 and im.size[0] > 4 * 100
     with pytest.raises(InputError):
         contact_sheet(tmp_path / "nothing", tmp_path / "x.png")
+
+
+def test_relight_matches_exposure_unless_absolute(obj: Path, tmp_path: Path) -> None:
+    np.save(tmp_path / "bright.npy", 10 * np.load(obj / "env_map.npy"))  # the same light in other units
+    runner = CliRunner()
+    base = ["relight", str(obj), "--env", str(tmp_path / "bright.npy"), "--out"]
+    assert runner.invoke(cli, base + [str(tmp_path / "m.png")]).exit_code == 0
+    assert np.abs(_read(tmp_path / "m.png") - _read(obj / "recon.png")).max() <= 1.0
+    assert runner.invoke(cli, base + [str(tmp_path / "a.png"), "--absolute"]).exit_code == 0
+    assert _read(tmp_path / "a.png").mean() > _read(obj / "recon.png").mean() + 5
