@@ -130,7 +130,7 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
         raise InputError("--batch-size and --threads must be >= 1, --workers >= 0")
     render = predictor.setup.render
     envs = environments(options.envs, render.env_height, render.env_width)
-    items, failures = collect_inputs(list(inputs), options.masks)
+    items, failures = collect_inputs(list(inputs), options.masks, exclude=options.out)
     summary = BatchSummary(failures=list(failures))
     for f in failures:
         say(f.line())

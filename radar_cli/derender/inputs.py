@@ -95,8 +95,8 @@ def _mask_for(image: Path, masks: Path | None) -> Path | None:
     return _existing(masks / f"{image.stem}.png") or _existing(masks / image.stem / MASK_FILE)
 
 
-def collect_inputs(paths: list[str | Path], masks: str | Path | None = None) -> tuple[list[InputItem],
-                                                                                      list[Failure]]:
+def collect_inputs(paths: list[str | Path], masks: str | Path | None = None,
+                   exclude: str | Path | None = None) -> tuple[list[InputItem], list[Failure]]:
     """Expand the command line's inputs into photos to de-render.
 
     Files must have an image suffix; folders are searched recursively for images (other files, such as a
@@ -106,6 +106,7 @@ def collect_inputs(paths: list[str | Path], masks: str | Path | None = None) -> 
     Args:
         paths: files and folders, in order.
         masks: optional folder of known silhouettes (<stem>.png or <stem>/mask.png).
+        exclude: a folder whose images are never inputs (the results folder, if it lies inside an input folder).
 
     Returns:
         (items, failures), items in input order without duplicates.
@@ -129,6 +130,9 @@ def collect_inputs(paths: list[str | Path], masks: str | Path | None = None) -> 
                 failures.append(Failure(str(path), f"not an image file (expected {', '.join(IMAGE_SUFFIXES)})"))
         else:
             failures.append(Failure(str(path), "no such file or folder"))
+    if exclude is not None:
+        skip = Path(exclude).resolve()
+        found = [item for item in found if not item.image_path.resolve().is_relative_to(skip)]
     return _unique(found, failures), failures
 
 

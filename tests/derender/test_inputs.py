@@ -83,3 +83,10 @@ def test_blank_photo_is_one_clear_error(tmp_path: Path) -> None:
     (item,), _ = collect_inputs([path])
     with pytest.raises(InputError, match="blank.png"):
         prepare(item, SIZE)
+
+
+def test_results_inside_an_input_folder_are_not_inputs(tmp_path: Path) -> None:
+    write_photo(tmp_path / "photos" / "a.png", 1)
+    write_photo(tmp_path / "photos" / "results" / "a" / "recon.png", 2)
+    items, _ = collect_inputs([tmp_path / "photos"], exclude=tmp_path / "photos" / "results")
+    assert [i.image_path.name for i in items] == ["a.png"]
