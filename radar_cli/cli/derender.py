@@ -22,7 +22,8 @@ from radar_cli.derender.predictor import Predictor
 @click.option("--masks", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Folder of known silhouettes (<stem>.png or <stem>/mask.png) used to crop.")
 @click.option("--crop", type=click.Choice(["auto", "none"]), default="auto", show_default=True,
-              help="auto: locate and crop the object in photos that are not square; none: pad to a square.")
+              help="auto: locate the object and crop around it as `radar masks` does (dataset samples are "
+                   "crops already); none: pad the whole photo to a square.")
 @click.option("--device", default="auto", show_default=True, help="auto, cpu, cuda or cuda:N.")
 @click.option("--views", type=click.IntRange(0, 360), default=8, show_default=True, help="Turntable frames.")
 @click.option("--view-size", type=click.IntRange(16, 1024), default=128, show_default=True,
