@@ -19,11 +19,11 @@ import torch
 from radar_cli.config import CameraConfig
 from radar_cli.sor.camera import pixel_rays, pixel_size
 from radar_cli.sor.pose import rotation_matrix, translation
-from radar_cli.sor.profile import check_sor, lerp_rows, row_slopes
+from radar_cli.errors import InputError
+from radar_cli.render.intersect import Found, search
+from radar_cli.sor.profile import check_sor, row_coordinate, row_slopes
 
-N_COARSE = 48  # coarse samples per ray span; the thinnest missed chord is ~1/3 pixel at 128 px
-N_REFINE = 8  # samples per refinement round of the silhouette minimum
-N_BISECT = 22  # bisection steps for first hit and exit (bracket shrinks by 4e6)
+CULL_SIGMAS = 6.0  # rays farther than this many sigmas from the bounding cylinder are not cast (sil = 0)
 
 
 @dataclass(frozen=True)
@@ -57,15 +57,26 @@ class _Rays:
     b: torch.Tensor  # M batch index
     o: torch.Tensor  # M x 3 origin (differentiable in pose)
     d: torch.Tensor  # M x 3 unit direction (differentiable in pose)
-    r: torch.Tensor  # M x L radius column, world units (differentiable)
+    rows: torch.Tensor  # B x L radius column, world units (differentiable)
     h: torch.Tensor  # M half-height, world units (differentiable)
+
+    def radius(self, v: torch.Tensor, values: torch.Tensor | None = None) -> torch.Tensor:
+        """Per-row values (B x L, default the radii) interpolated at axial coordinates v (M x S), clamped."""
+        values = self.rows if values is None else values
+        n_rows = values.shape[1]
+        t = row_coordinate(v, n_rows)
+        i0 = t.detach().floor().clamp(0, n_rows - 2).long()
+        w = t - i0.to(t.dtype)
+        flat = values.reshape(-1)
+        base = self.b[:, None] * n_rows + i0
+        a, b = flat[base], flat[base + 1]
+        return a + (b - a) * w
 
     def field(self, s: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         """Lateral term rho - r(y), cap term |y| - h, and points p, at ray parameters s (M x S)."""
         p = self.o[:, None, :] + s[..., None] * self.d[:, None, :]  # M x S x 3
         rho = torch.sqrt(p[..., 0] ** 2 + p[..., 2] ** 2 + 1e-20)
-        v = -p[..., 1] / self.h[:, None]
-        lateral = rho - lerp_rows(self.r, v)
+        lateral = rho - self.radius(-p[..., 1] / self.h[:, None])
         cap = p[..., 1].abs() - self.h[:, None]
         return lateral, cap, p
 
@@ -97,9 +108,7 @@ def cast_rays(
         Hits with H = W = size.
     """
     check_sor(radius, height, pose)
-    if size < 1 or sigma_px <= 0:
-        from radar_cli.errors import InputError
-
+    if not (isinstance(size, int) and size >= 1) or not (math.isfinite(sigma_px) and sigma_px > 0):
         raise InputError(f"size must be >= 1 and sigma_px > 0, got size={size}, sigma_px={sigma_px}")
     n_batch, dev, dt = radius.shape[0], radius.device, radius.dtype
     sigma = sigma_px * pixel_size(size, camera)
@@ -110,23 +119,25 @@ def cast_rays(
     d_obj = dirs @ rot  # B x P x 3: R^T applied to each ray direction
     r_world, h_world = radius * camera.r_max, height * camera.r_max
 
-    s_near, s_far = _span(origin.detach(), d_obj.detach(), r_world.detach().amax(1) + 4 * sigma,
-                          h_world.detach() + 4 * sigma)
+    s_near, s_far = _span(origin.detach(), d_obj.detach(), r_world.detach().amax(1) + CULL_SIGMAS * sigma,
+                          h_world.detach() + CULL_SIGMAS * sigma)
     active = s_far > s_near  # B x P
     b_idx, p_idx = active.nonzero(as_tuple=True)
-    rays = _Rays(b_idx, origin[b_idx], d_obj[b_idx, p_idx], r_world[b_idx], h_world[b_idx])
+    rays = _Rays(b_idx, origin[b_idx], d_obj[b_idx, p_idx], r_world, h_world[b_idx])
     flat = b_idx * d_obj.shape[1] + p_idx
 
-    found = _search(rays, s_near[b_idx, p_idx], s_far[b_idx, p_idx])
-    g = rays.implicit(found.s_min[:, None])[:, 0]  # differentiable margin, world units
-    scale = _margin_scale(g.detach(), flat, n_batch, size, sigma, pixel_size(size, camera))
-    sil_m = torch.sigmoid(-g / (sigma * scale))
+    found = search(rays.o.detach(), rays.d.detach(), r_world.detach(), b_idx, rays.h.detach(),
+                   s_near[b_idx, p_idx], s_far[b_idx, p_idx])
+    g = _margin(rays, found.s_min)  # differentiable margin, world units
+    # g is close to the distance from the ray to the solid, ~ pixels * pixel size at the object; the taper
+    # takes the soft silhouette to exactly 0 at the culling margin, so it stays continuous in every input
+    sil_m = torch.sigmoid(-g / sigma) * (CULL_SIGMAS - g / sigma).clamp(0.0, 1.0)
 
-    hit_pts, normals, uv = _surface_at(rays, found, height[b_idx], radius[b_idx])
+    hit_pts, normals, uv = _surface_at(rays, found, row_slopes(radius, height))
     cam_pts = (rot[b_idx] @ hit_pts[..., None])[..., 0] + translation(pose, camera)[b_idx]
     cam_nrm = (rot[b_idx] @ normals[..., None])[..., 0]
 
-    total, P = n_batch * d_obj.shape[1], d_obj.shape[1]
+    total = n_batch * d_obj.shape[1]
     hit_m = found.hit
     def scatter(values: torch.Tensor, fill: float = 0.0) -> torch.Tensor:
         out = torch.full((total,) + values.shape[1:], fill, device=dev, dtype=values.dtype)
@@ -139,25 +150,25 @@ def cast_rays(
     points = scatter(cam_pts).view(n_batch, size, size, 3)
     normal = scatter(cam_nrm * hit_m[:, None].to(dt)).view(n_batch, size, size, 3)
     uv_img = scatter(uv).view(n_batch, size, size, 2)
-    del P
     return Hits(sil, mask, inner, depth, points, normal, uv_img)
 
 
-def _margin_scale(g: torch.Tensor, flat: torch.Tensor, n_batch: int, size: int, sigma: float,
-                  pix: float) -> torch.Tensor:
-    """Per-ray |image-space gradient| of the margin g (dimensionless, no grad), clamped to [0.2, 5].
+def _margin(rays: _Rays, s_min: torch.Tensor) -> torch.Tensor:
+    """g = min_s F along each ray (M), differentiable by the envelope theorem.
 
-    min_s F is not a distance in the image: a ray nicking the rim of a tilted base stays shallow for many pixels.
-    Dividing g by how fast it changes from pixel to pixel turns it into an approximate signed distance in the
-    image, so the soft silhouette is about sigma_px wide on every edge.
+    At a smooth minimum dg/dtheta = dF/dtheta at the (no-grad) minimiser. The minimum often sits on a kink of F
+    instead (the rim, where the lateral and cap terms cross, or a profile row): there F = max(f_left, f_right)
+    locally and dg/dtheta = lam dF_left/dtheta + (1 - lam) dF_right/dtheta with lam = b / (b - a) for the one-sided
+    slopes a <= 0 <= b (the minimax theorem). Both pieces are sampled a hair either side of the minimiser.
     """
-    grid = torch.full((n_batch * size * size,), 8 * sigma, device=g.device, dtype=g.dtype)
-    grid = grid.index_put((flat,), g).view(n_batch, 1, size, size)
-    padded = torch.nn.functional.pad(grid, (1, 1, 1, 1), mode="replicate")
-    gx = 0.5 * (padded[..., 1:-1, 2:] - padded[..., 1:-1, :-2])
-    gy = 0.5 * (padded[..., 2:, 1:-1] - padded[..., :-2, 1:-1])
-    mag = (torch.sqrt(gx * gx + gy * gy) / pix).clamp(0.2, 5.0)
-    return mag.view(-1)[flat]
+    delta = 1e-4 * rays.h.detach()
+    s = torch.stack([s_min - delta, s_min, s_min + delta], dim=1)  # M x 3
+    f = rays.implicit(s)
+    with torch.no_grad():
+        left = ((f[:, 1] - f[:, 0]) / delta).clamp_max(0.0)
+        right = ((f[:, 2] - f[:, 1]) / delta).clamp_min(0.0)
+        lam = torch.where(right - left > 1e-6, right / (right - left + 1e-30), torch.full_like(left, 0.5))
+    return f[:, 1].detach() + lam * (f[:, 0] - f[:, 0].detach()) + (1 - lam) * (f[:, 2] - f[:, 2].detach())
 
 
 def _span(origin: torch.Tensor, d: torch.Tensor, rb: torch.Tensor, hb: torch.Tensor):
@@ -179,71 +190,7 @@ def _span(origin: torch.Tensor, d: torch.Tensor, rb: torch.Tensor, hb: torch.Ten
     return lo, hi
 
 
-@dataclass(frozen=True)
-class _Found:
-    s_min: torch.Tensor  # M, parameter of the minimum of F (no grad)
-    s_hit: torch.Tensor  # M, parameter of the shaded hit (no grad)
-    hit: torch.Tensor  # M bool
-    inner: torch.Tensor  # M bool, shaded hit is on the inside
-    cap: torch.Tensor  # M bool, shaded hit is on the bottom disc
-
-
-@torch.no_grad()
-def _search(rays: _Rays, s_near: torch.Tensor, s_far: torch.Tensor) -> _Found:
-    """Find, per ray, the minimiser of F and the visible surface point (no autograd)."""
-    m = s_near.shape[0]
-    t = torch.linspace(0.0, 1.0, N_COARSE, device=s_near.device, dtype=s_near.dtype)
-    step = (s_far - s_near) / (N_COARSE - 1)
-    s = s_near[:, None] + (s_far - s_near)[:, None] * t  # M x N
-    f = rays.implicit(s)
-    k = f.argmin(dim=1)
-    s_min, width = s.gather(1, k[:, None])[:, 0], step
-    for _ in range(2):  # refine the minimum on a finer grid around the best sample
-        offs = torch.linspace(-1.0, 1.0, N_REFINE, device=s.device, dtype=s.dtype)
-        cand = s_min[:, None] + width[:, None] * offs
-        fc = rays.implicit(cand)
-        s_min = cand.gather(1, fc.argmin(1, keepdim=True))[:, 0]
-        width = width * (2.0 / (N_REFINE - 1))
-    f_min = rays.implicit(s_min[:, None])[:, 0]
-
-    neg = f < 0
-    any_neg = neg.any(1)
-    hit = any_neg | (f_min < 0)
-    k1 = torch.where(any_neg, neg.float().argmax(1), (s_min - s_near).div(step.clamp_min(1e-12)).floor().long())
-    k1 = k1.clamp(1, N_COARSE - 1)
-    s_in = torch.where(any_neg, s.gather(1, k1[:, None])[:, 0], s_min)
-    s_out = s.gather(1, (k1 - 1)[:, None])[:, 0]
-    s_in, s_out = torch.where(hit, s_in, s_min), torch.where(hit, s_out, s_min)
-    entry = _bisect(rays, s_out, s_in)
-    lateral, cap, p = rays.field(entry[:, None])
-    via_cap = cap[:, 0] > lateral[:, 0]
-    mouth = hit & via_cap & (p[:, 0, 1] > 0)
-
-    # inside the mouth: the visible point is where the ray leaves the solid again
-    after_out = (s > s_in[:, None]) & ~neg
-    k2 = after_out.float().argmax(1).clamp(1, N_COARSE - 1)
-    prev_in = neg.gather(1, (k2 - 1)[:, None])[:, 0] & (s.gather(1, (k2 - 1)[:, None])[:, 0] > s_in)
-    lo2 = torch.where(prev_in, s.gather(1, (k2 - 1)[:, None])[:, 0], s_in)
-    exit_s = _bisect(rays, s.gather(1, k2[:, None])[:, 0], lo2)
-    lat2, cap2, _ = rays.field(exit_s[:, None])
-    s_hit = torch.where(mouth, exit_s, entry)
-    on_cap = torch.where(mouth, cap2[:, 0] > lat2[:, 0], via_cap)
-    del m
-    return _Found(s_min, torch.where(hit, s_hit, s_min), hit, mouth, on_cap & hit)
-
-
-def _bisect(rays: _Rays, s_outside: torch.Tensor, s_inside: torch.Tensor) -> torch.Tensor:
-    """Root of F between a point outside (F > 0) and one inside (F < 0), as the inside end of the final bracket."""
-    a, b = s_outside.clone(), s_inside.clone()
-    for _ in range(N_BISECT):
-        mid = 0.5 * (a + b)
-        inside = rays.implicit(mid[:, None])[:, 0] < 0
-        b = torch.where(inside, mid, b)
-        a = torch.where(inside, a, mid)
-    return 0.5 * (a + b)
-
-
-def _surface_at(rays: _Rays, found: _Found, height: torch.Tensor, radius: torch.Tensor):
+def _surface_at(rays: _Rays, found: Found, slopes: torch.Tensor):
     """Differentiable hit points (canonical, M x 3), normals of the seen side (M x 3) and uv (M x 2)."""
     s0 = found.s_hit
     lateral, cap, _ = rays.field(s0[:, None])
@@ -260,7 +207,7 @@ def _surface_at(rays: _Rays, found: _Found, height: torch.Tensor, radius: torch.
 
     rho = torch.sqrt(p[:, 0] ** 2 + p[:, 2] ** 2 + 1e-20)
     v = (-p[:, 1] / rays.h).clamp(-1.0, 1.0)
-    slope = lerp_rows(row_slopes(radius, height), v[:, None])[:, 0]
+    slope = rays.radius(v[:, None], slopes)[:, 0]
     side = torch.stack([p[:, 0] / rho, -slope, p[:, 2] / rho], dim=-1)
     side = side / side.norm(dim=-1, keepdim=True)
     side = torch.where(found.inner[:, None], -side, side)

@@ -18,6 +18,7 @@ from radar_cli.config import CameraConfig, RenderConfig
 from radar_cli.render.lighting import check_material, compose, shading_factors, upsample
 from radar_cli.render.raycast import Hits, cast_rays
 from radar_cli.render.texture import render_texture
+from radar_cli.sor.profile import check_sor
 from radar_cli.sor.surface import FRONT_SPAN, FULL_SPAN, surface_grid
 
 
@@ -66,6 +67,7 @@ def shade(
     Returns:
         Shading at the albedo's resolution.
     """
+    check_sor(radius, height, pose)
     dims = check_shape(albedo, "B 3 Ht Wt", "albedo", {"B": radius.shape[0]})
     check_shape(env, "B He We", "env", dims)
     check_material(alpha, rho, env)
@@ -135,14 +137,13 @@ def render_view(
     Returns:
         (image B x 3 x H x W tone-mapped over `background`, mask B x 1 x H x W float coverage).
     """
+    check_shape(albedo_full, "B 3 Ht Wt", "albedo_full", {"B": radius.shape[0]})
     albedo = rotate_full_map(albedo_full, yaw_deg)
     shading = shade(radius, height, pose, albedo, env, alpha, rho, render, camera, span=FULL_SPAN)
     hits = cast_rays(radius, height, pose, size, camera, render.sil_sigma_px)
-    image, mask = render_texture(hits, shading.texture, front_only=False, inside_dim=render.inside_dim,
-                                 background=background)
-    del mask
-    coverage = torch.where(hits.mask, torch.ones_like(hits.sil), hits.sil)[:, None]
-    return image, coverage
+    image, _ = render_texture(hits, shading.texture, front_only=False, inside_dim=render.inside_dim,
+                              background=background)
+    return image, hits.sil[:, None]
 
 
 def sample_env(env: torch.Tensor, size: tuple[int, int]) -> torch.Tensor:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import torch
 import torch.nn.functional as F
 
-from radar_cli.checks import check_shape
+from radar_cli.checks import check_finite, check_shape
 from radar_cli.config import CameraConfig
 from radar_cli.render.raycast import Hits
 from radar_cli.sor.camera import project
@@ -47,7 +47,8 @@ def render_texture(
         background: value of pixels without surface.
 
     Returns:
-        image: B x C x H x W, anti-aliased by the soft silhouette at the object's outline.
+        image: B x C x H x W; full renders are blended over the background by the soft silhouette, so they are
+            anti-aliased and continuous in the shape at the outline.
         mask: B x 1 x H x W float, the pixels that carry texture (the rendered frontal silhouette if front_only).
     """
     dims = check_shape(hits.sil, "B H W", "hits.sil")
@@ -67,9 +68,8 @@ def render_texture(
     color = F.grid_sample(padded, torch.stack([u_pad, v], -1), mode="bilinear", padding_mode="border",
                           align_corners=False)
     dim = torch.where(hits.inner, inside_dim, 1.0).to(texture.dtype)[:, None]
-    coverage = torch.where(hits.mask, torch.ones_like(hits.sil), hits.sil)[:, None]
-    # the outline is anti-aliased by the soft silhouette; inside the vase the hit decides
-    alpha = torch.where(hits.mask[:, None], coverage, hits.sil[:, None])
+    # the soft silhouette is the coverage: ~1 inside, anti-aliased and continuous across the outline
+    alpha = hits.sil[:, None]
     image = color * dim * alpha + background * (1 - alpha)
     return image, hits.mask[:, None].to(texture.dtype)
 
@@ -97,6 +97,7 @@ def unwrap(
     """
     check_sor(radius, height, pose)
     check_shape(image, "B C H W", "image", {"B": radius.shape[0]})
+    check_finite(image, "image")
     rows, cols = tex_size
     grid = surface_grid(radius, height, pose, rows, cols, camera)
     xy = project(grid.points, camera)  # B x rows x cols x 2

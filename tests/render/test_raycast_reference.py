@@ -1,0 +1,51 @@
+"""Check 1 of issue 2: silhouette and depth against trimesh ray casting of a dense (K = 256) triangle mesh."""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+import trimesh
+
+from radar_cli.config import CameraConfig
+from radar_cli.render.raycast import cast_rays
+from radar_cli.sor.camera import pixel_rays, project
+from radar_cli.sor.mesh import triangulate
+from radar_cli.sor.pose import object_to_camera
+
+SIZE = 128
+N_SHAPES = 20
+
+
+def reference_hits(radius, height, pose, camera):
+    """(mask P bool, depth P) from trimesh for one shape, rays limited to the mesh's projected bounding box."""
+    mesh = triangulate(radius, height, n_cols=256, camera=camera)
+    verts = object_to_camera(mesh.vertices[None], pose, camera)[0]
+    tm = trimesh.Trimesh(verts.numpy(), mesh.faces.numpy(), process=False)
+    dirs = pixel_rays(SIZE, camera, dtype=torch.float64).reshape(-1, 3)
+    dirs = dirs / dirs.norm(dim=-1, keepdim=True)
+    xy = project(verts, camera)
+    img = project(dirs[:, None, :] * 5.0, camera)[:, 0]
+    lo, hi = xy.min(0).values - 0.05, xy.max(0).values + 0.05
+    cand = ((img >= lo) & (img <= hi)).all(-1).nonzero()[:, 0].numpy()
+    mask, depth = np.zeros(SIZE * SIZE, bool), np.zeros(SIZE * SIZE)
+    loc, ray_idx, _ = tm.ray.intersects_location(np.zeros((len(cand), 3)), dirs[cand].numpy(), multiple_hits=False)
+    mask[cand[ray_idx]] = True
+    depth[cand[ray_idx]] = loc[:, 2]
+    return mask, depth
+
+
+def test_silhouette_and_depth_match_trimesh(random_sor):
+    camera = CameraConfig()
+    radius, height, pose = random_sor(N_SHAPES, seed=1)
+    hits = cast_rays(radius, height, pose, SIZE, camera)
+    ious, depth_errs = [], []
+    for i in range(N_SHAPES):
+        ref_mask, ref_depth = reference_hits(radius[i : i + 1], height[i : i + 1], pose[i : i + 1], camera)
+        mask = hits.mask[i].reshape(-1).numpy()
+        depth = hits.depth[i].reshape(-1).detach().numpy()
+        ious.append((mask & ref_mask).sum() / (mask | ref_mask).sum())
+        both = mask & ref_mask
+        depth_errs.append(np.abs(depth[both] - ref_depth[both]).mean() / camera.distance)
+    assert np.mean(ious) >= 0.99, ious
+    assert min(ious) >= 0.97, ious
+    assert max(depth_errs) <= 0.005, depth_errs

@@ -1,0 +1,67 @@
+"""Check 5 of issue 2: one-texel environment light: Lambert diffuse value and the Eq. 7-8 specular peak within 2%."""
+
+from __future__ import annotations
+
+import math
+
+import torch
+
+from radar_cli.config import RenderConfig
+from radar_cli.render.lighting import compose, env_directions, shading_factors, tone_map
+from radar_cli.render.scene import shade
+
+HE, WE = 16, 48
+
+
+def one_texel_env(i: int, j: int, value: float = 3.0) -> torch.Tensor:
+    env = torch.zeros(1, HE, WE)
+    env[0, i, j] = value
+    return env
+
+
+def test_lambert_value_on_a_white_cylinder():
+    i, j, value = 6, 20, 3.0
+    env = one_texel_env(i, j, value)
+    dirs, solid = env_directions(HE, WE)
+    light, w = dirs[i * WE + j], solid[i * WE + j]
+    radius = torch.full((1, 32), 0.4)
+    height, pose = torch.tensor([0.8]), torch.zeros(1, 4)
+    cfg = RenderConfig(shading_height=32, shading_width=32)
+    albedo = torch.ones(1, 3, 32, 32)
+    shading = shade(radius, height, pose, albedo, env, torch.tensor([10.0]), torch.tensor([0.0]), cfg)
+    # a cylinder at zero pose: normals are horizontal, n = (sin phi, 0, -cos phi)
+    expected = value * w * (shading.normals[0].permute(1, 2, 0) @ light).clamp_min(0)  # Ht x Wt
+    assert (shading.normals[0, 1].abs() < 1e-5).all()
+    lit = expected > 0.05 * expected.max()
+    assert lit.any()
+    rel = (shading.diffuse[0, 0][lit] - expected[lit]).abs() / expected[lit]
+    assert rel.max() <= 0.02
+    assert torch.allclose(shading.texture[0, :, lit], tone_map(expected[lit]).expand(3, -1), rtol=0.02)
+
+
+def test_specular_peak_matches_normalised_phong():
+    i, j, value = 5, 27, 2.0
+    dirs, solid = env_directions(HE, WE)
+    light, w = dirs[i * WE + j], solid[i * WE + j]
+    view = torch.tensor([0.3, -0.2, -1.0])
+    view = view / view.norm()
+    half = (light + view) / (light + view).norm()  # mirror direction: R = P exactly at this normal
+    tilt = torch.tensor([0.0, 1.0, 0.0])
+    tilted = half * math.cos(0.05) + torch.linalg.cross(half, tilt) / torch.linalg.cross(half, tilt).norm() * math.sin(0.05)
+    normals = torch.stack([half, tilted])[None, None]  # 1 x 1 x 2 x 3
+    views = view.expand(1, 1, 2, 3)
+    for alpha in (1.0, 20.0, 150.0):
+        diffuse, specular = shading_factors(normals, views, one_texel_env(i, j, value), torch.tensor([alpha]))
+        peak = (alpha + 1) / (2 * math.pi) * value * w
+        assert abs(float(specular[0, 0, 0]) - peak) <= 0.02 * peak
+        assert float(specular[0, 0, 1]) < float(specular[0, 0, 0])  # the lobe falls off away from the mirror
+        assert abs(float(diffuse[0, 0, 0]) - value * w * float(light @ half)) <= 0.02 * value * w
+
+
+def test_compose_is_tone_mapped_sum():
+    albedo = torch.rand(2, 3, 4, 5)
+    diffuse, specular = torch.rand(2, 4, 5), torch.rand(2, 4, 5)
+    rho = torch.tensor([0.3, 0.7])
+    out = compose(albedo, diffuse, specular, rho)
+    ref = (albedo * diffuse[:, None] + rho[:, None, None, None] * specular[:, None]) ** (1 / 2.2)
+    assert torch.allclose(out, ref, atol=1e-5)
