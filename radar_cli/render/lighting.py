@@ -39,7 +39,7 @@ def shading_factors(
         normals: B x H x W x 3 unit normals (camera frame).
         view: B x H x W x 3 unit directions towards the camera (P in the paper).
         env: B x He x We environment map, >= 0.
-        alpha: B shininess.
+        alpha: B shininess (>= 1 keeps the lobe's gradient finite where it vanishes).
 
     Returns:
         (I_d, I_s), each B x H x W.
@@ -51,16 +51,80 @@ def shading_factors(
     n_batch, h, w, _ = normals.shape
     dirs, solid = env_directions(env.shape[1], env.shape[2], env.device, env.dtype)
     radiance = env.reshape(n_batch, -1) * solid  # B x E
-    n = normals.reshape(n_batch, -1, 3)
-    p = view.reshape(n_batch, -1, 3)
-    ln = n @ dirs.T  # B x N x E
-    lp = p @ dirs.T
-    np_ = (n * p).sum(-1, keepdim=True)  # B x N x 1
-    diffuse = ln.clamp_min(0) @ radiance[..., None]  # B x N x 1
-    rp = (2 * ln * np_ - lp).clamp_min(0) * (ln > 0)  # reflected light . view, lights above the surface only
-    lobe = torch.exp(alpha[:, None, None] * torch.log(rp + EPS))  # rp ** alpha, finite gradient at 0
-    specular = (alpha[:, None, None] + 1) / (2 * math.pi) * (lobe @ radiance[..., None])
+    diffuse, specular = _Phong.apply(normals.reshape(n_batch, -1, 3), view.reshape(n_batch, -1, 3), radiance,
+                                     alpha, dirs)
     return diffuse.view(n_batch, h, w), specular.view(n_batch, h, w)
+
+
+CHUNK_ELEMENTS = 1 << 22  # B x samples x lights per chunk: bounds the B x N x E intermediates (16 MiB in float32)
+
+
+def _phong_chunk(n: torch.Tensor, p: torch.Tensor, dirs: torch.Tensor, alpha: torch.Tensor):
+    """Per-light terms for one chunk of samples (B x n x 3 each), all B x n x E: clamped L.N, R.P (0 where the
+    light is below the surface or the lobe points away), log of it, and the lobe max(0, R.P)^alpha.
+    R_i . P = L_i . R_v with R_v = 2 (N.P) N - P, the view direction mirrored about N."""
+    ln = n @ dirs.T
+    mirror = 2 * (n * p).sum(-1, keepdim=True) * n - p  # B x n x 3
+    rp = (mirror @ dirs.T).clamp_min_(0.0).masked_fill_(ln <= 0, 0.0)
+    log_rp = torch.log(rp.clamp_min(TINY))
+    # exp(alpha log x) is much faster than a broadcast pow; the floor keeps exp away from denormals (slow on CPU)
+    lobe = torch.exp((log_rp * alpha[:, None, None]).clamp_min_(-60.0))
+    return ln.clamp_min_(0.0), rp, log_rp, lobe
+
+
+TINY = 1e-30  # floor inside log(R.P): the lobe of a dark light is exp(-69 alpha) ~ 0, never NaN
+
+
+class _Phong(torch.autograd.Function):
+    """Eq. 6-7 summed over all environment texels, in chunks of samples, with an analytic backward that
+    recomputes each chunk: memory stays O(chunk) instead of several B x N x E tensors kept for autograd."""
+
+    @staticmethod
+    def forward(ctx, n, p, radiance, alpha, dirs):
+        ctx.save_for_backward(n, p, radiance, alpha, dirs)
+        step = _chunk(n, dirs)
+        rad = radiance[..., None]  # B x E x 1
+        diffuse, lobe_sum = [], []
+        for i in range(0, n.shape[1], step):
+            ln, _, _, lobe = _phong_chunk(n[:, i : i + step], p[:, i : i + step], dirs, alpha)
+            diffuse.append((ln @ rad)[..., 0])
+            lobe_sum.append((lobe @ rad)[..., 0])
+        norm = (alpha[:, None] + 1) / (2 * math.pi)
+        return torch.cat(diffuse, 1), norm * torch.cat(lobe_sum, 1)
+
+    @staticmethod
+    def backward(ctx, g_diffuse, g_specular):
+        n, p, radiance, alpha, dirs = ctx.saved_tensors
+        step = _chunk(n, dirs)
+        norm = (alpha + 1) / (2 * math.pi)  # B
+        rad = radiance[..., None]  # B x E x 1
+        g_n, g_p = torch.zeros_like(n), torch.zeros_like(p)
+        g_rad, g_alpha = torch.zeros_like(radiance), torch.zeros_like(alpha)
+        for i in range(0, n.shape[1], step):
+            sl = slice(i, i + step)
+            ln, rp, log_rp, lobe = _phong_chunk(n[:, sl], p[:, sl], dirs, alpha)
+            gd = g_diffuse[:, sl, None]  # B x n x 1
+            gs = g_specular[:, sl, None] * norm[:, None, None]
+            g_rad += (ln.transpose(1, 2) @ gd + lobe.transpose(1, 2) @ gs)[..., 0]
+            # I_s = norm * sum lobe rad: d/d alpha = sum lobe rad / (2 pi) + norm * sum lobe log(rp) rad
+            g_alpha += (g_specular[:, sl, None] * (lobe @ rad)).sum((1, 2)) / (2 * math.pi)
+            g_alpha += (gs * ((lobe * log_rp) @ rad)).sum((1, 2))
+            # d lobe / d rp = alpha rp^(alpha - 1) where the light counts; d diffuse / d ln = rad where lit
+            g_rp = (lobe / rp.clamp_min(TINY)).masked_fill_(lobe <= 1e-26, 0.0) * radiance[:, None, :]
+            g_rp *= gs * alpha[:, None, None]
+            g_ln = (gd * radiance[:, None, :]).masked_fill_(ln <= 0, 0.0)
+            g_mirror = g_rp @ dirs  # B x n x 3
+            nk, pk = n[:, sl], p[:, sl]
+            np_ = (nk * pk).sum(-1, keepdim=True)
+            gm_n = (g_mirror * nk).sum(-1, keepdim=True)
+            g_n[:, sl] = g_ln @ dirs + 2 * (np_ * g_mirror + gm_n * pk)
+            g_p[:, sl] = 2 * gm_n * nk - g_mirror
+        return g_n, g_p, g_rad, g_alpha, None
+
+
+def _chunk(n: torch.Tensor, dirs: torch.Tensor) -> int:
+    """Samples per chunk so one B x chunk x E tensor holds about CHUNK_ELEMENTS values."""
+    return max(1, CHUNK_ELEMENTS // max(1, n.shape[0] * dirs.shape[0]))
 
 
 def tone_map(x: torch.Tensor, gamma: float = GAMMA) -> torch.Tensor:
