@@ -20,6 +20,7 @@ COMMANDS: list[tuple[str, str]] = [
     ("radar_cli.cli.derender", "derender"),
     ("radar_cli.cli.relight", "relight"),
     ("radar_cli.cli.eval", "eval"),
+    ("radar_cli.cli.bench", "bench"),
 ]
 
 

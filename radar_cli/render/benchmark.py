@@ -25,6 +25,7 @@ class BenchResult:
     batch: int
     seconds: float
     seconds_forward: float
+    cpu_seconds: float  # process CPU time of one forward+backward (all threads)
     peak_mib: float
     memory: str  # what peak_mib measures
 
@@ -88,12 +89,12 @@ def bench_size(size: int, batch: int, device: torch.device, repeats: int = 3,
     render = bench_config(size)
     x = random_inputs(batch, size, render, device)
     render_step(x, size, render, camera).backward()  # warm-up (allocator, first-call overheads)
-    rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     if device.type == "cuda":
         torch.cuda.reset_peak_memory_stats(device)
-    fwd, total = [], []
+    fwd, total, cpu = [], [], []
     for _ in range(repeats):
         _sync(device)
+        c0 = time.process_time()
         t0 = time.perf_counter()
         loss = render_step(x, size, render, camera)
         _sync(device)
@@ -102,19 +103,27 @@ def bench_size(size: int, batch: int, device: torch.device, repeats: int = 3,
         _sync(device)
         fwd.append(t1 - t0)
         total.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
     if device.type == "cuda":
         peak, what = torch.cuda.max_memory_allocated(device) / 2**20, "cuda max_memory_allocated"
     else:
-        peak, what = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, "process peak RSS (ru_maxrss)"
-        del rss0
-    return BenchResult(size, batch, sorted(total)[len(total) // 2], sorted(fwd)[len(fwd) // 2], round(peak, 1), what)
+        peak, what = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, "process peak RSS so far (ru_maxrss)"
+    return BenchResult(size, batch, _median(total), _median(fwd), _median(cpu), round(peak, 1), what)
 
 
-def run_benchmark(sizes: list[int], batch: int, device_name: str = "auto", repeats: int = 3) -> dict:
+def _median(values: list[float]) -> float:
+    return round(sorted(values)[len(values) // 2], 4)
+
+
+def run_benchmark(sizes: list[int], batch: int, device_name: str = "auto", repeats: int = 3,
+                  threads: int = 0) -> dict:
     """Benchmark every size in increasing order; a JSON-ready dict."""
-    if batch < 1 or not sizes or min(sizes) < 8:
-        raise InputError(f"--batch must be >= 1 and --sizes >= 8, got batch={batch}, sizes={sizes}")
+    if batch < 1 or repeats < 1 or not sizes or min(sizes) < 8 or max(sizes) > 2048:
+        raise InputError(f"--batch and --repeats must be >= 1 and --sizes in [8, 2048], got batch={batch}, "
+                         f"repeats={repeats}, sizes={sizes}")
     device = resolve_device(device_name)
+    if threads > 0:
+        torch.set_num_threads(threads)
     torch.manual_seed(0)
     results = [bench_size(s, batch, device, repeats) for s in sorted(sizes)]
     return {

@@ -1,0 +1,27 @@
+"""`radar bench render`: prints JSON with one timing per size; bad options exit 2 with one line."""
+
+from __future__ import annotations
+
+import json
+
+from click.testing import CliRunner
+
+from radar_cli.cli import cli
+
+
+def test_bench_render_prints_json_per_size():
+    result = CliRunner().invoke(cli, ["bench", "render", "--device", "cpu", "--sizes", "16,24", "--batch", "2",
+                                      "--repeats", "1"])
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.output)
+    assert report["device"] == "cpu"
+    assert [r["size"] for r in report["results"]] == [16, 24]
+    for r in report["results"]:
+        assert r["seconds"] > 0 and r["seconds_forward"] > 0 and r["peak_mib"] > 0 and r["batch"] == 2
+
+
+def test_bench_render_rejects_bad_sizes():
+    result = CliRunner().invoke(cli, ["bench", "render", "--device", "cpu", "--sizes", "64,abc"])
+    assert result.exit_code == 2 and "--sizes" in result.output
+    result = CliRunner().invoke(cli, ["bench", "render", "--device", "cpu", "--sizes", "4"])
+    assert result.exit_code == 2 and "--sizes" in result.output
