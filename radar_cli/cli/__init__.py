@@ -11,16 +11,17 @@ import click
 from radar_cli import __version__
 from radar_cli.errors import RadarError
 
-# (module, command attribute): one line per working subcommand.
-COMMANDS: list[tuple[str, str]] = [
-    ("radar_cli.cli.fetch", "fetch"),
-    ("radar_cli.cli.masks", "masks"),
-    ("radar_cli.cli.synth", "synth"),
-    ("radar_cli.cli.train", "train"),
-    ("radar_cli.cli.derender", "derender"),
-    ("radar_cli.cli.relight", "relight"),
-    ("radar_cli.cli.eval", "eval"),
-    ("radar_cli.cli.bench", "bench"),
+# (command name, module, attribute, one-line help): one line per working subcommand, in pipeline order.
+# Modules are imported only when their command runs, so `radar --help` and `radar fetch` never load torch.
+COMMANDS: list[tuple[str, str, str, str]] = [
+    ("fetch", "radar_cli.cli.fetch", "fetch", "Harvest a museum's open-access collection (Met Collection API)."),
+    ("masks", "radar_cli.cli.masks", "masks", "Crop photographs and make silhouettes (GrabCut), with quality scores."),
+    ("synth", "radar_cli.cli.synth", "synth", "Render synthetic vases with full ground truth."),
+    ("train", "radar_cli.cli.train", "train", "Train the RADAR model on a prepared or synthetic dataset."),
+    ("derender", "radar_cli.cli.derender", "derender", "De-render photographs into per-object folders of exports."),
+    ("relight", "radar_cli.cli.relight", "relight", "Re-render a de-rendered object under new light and view."),
+    ("eval", "radar_cli.cli.eval", "eval_cmd", "Score de-rendering results against synthetic ground truth."),
+    ("bench", "radar_cli.cli.bench", "bench", "Time a stage of the pipeline and print JSON."),
 ]
 
 
@@ -31,7 +32,21 @@ class RadarUsageError(click.ClickException):
 
 
 class RadarGroup(click.Group):
-    """Click group that turns RadarError (bad input, config, checkpoint) into a one-line message."""
+    """Click group with lazily imported subcommands that turns RadarError into a one-line message."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return [name for name, _module, _attr, _help in COMMANDS]
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        for name, module, attr, _help in COMMANDS:
+            if name == cmd_name:
+                return getattr(importlib.import_module(module), attr)
+        return None
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        rows = [(name, help_text) for name, _module, _attr, help_text in COMMANDS]
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
 
     def invoke(self, ctx: click.Context):  # type: ignore[override]
         try:
@@ -45,10 +60,6 @@ class RadarGroup(click.Group):
 def cli() -> None:
     """De-render photographs of vases and other solids of revolution into 3D shape, pose, albedo, lighting and
     material. Subcommands chain: fetch -> masks -> train -> derender."""
-
-
-for _module, _attr in COMMANDS:
-    cli.add_command(getattr(importlib.import_module(_module), _attr))
 
 
 def main() -> None:
