@@ -47,19 +47,22 @@ class _Ray:
     oy: torch.Tensor
     dy: torch.Tensor
 
-    def rho(self, t: torch.Tensor, idx: torch.Tensor | None = None) -> torch.Tensor:
-        qa, qb, qc = (self.qa, self.qb, self.qc) if idx is None else (self.qa[idx], self.qb[idx], self.qc[idx])
+    def take(self, idx: torch.Tensor) -> "_Ray":
+        """The rays at indices idx (one per (ray, segment) pair)."""
+        return _Ray(*(x.index_select(0, idx) for x in (self.qa, self.qb, self.qc, self.oy, self.dy)))
+
+    def rho(self, t: torch.Tensor) -> torch.Tensor:
+        qa, qb, qc = self.qa, self.qb, self.qc
         if t.dim() > qa.dim():
             qa, qb, qc = qa[:, None], qb[:, None], qc[:, None]
         return torch.sqrt((qa * t * t + qb * t + qc).clamp_min(0.0))
 
 
-def _cone_roots(ray: _Ray, alpha: torch.Tensor, beta: torch.Tensor, idx: torch.Tensor | None = None):
+def _cone_roots(ray: _Ray, alpha: torch.Tensor, beta: torch.Tensor):
     """Both parameters t where rho(t) = alpha + beta t (on the nappe alpha + beta t >= 0), inf where none."""
-    qa, qb, qc = (ray.qa, ray.qb, ray.qc) if idx is None else (ray.qa[idx], ray.qb[idx], ray.qc[idx])
-    a2 = qa - beta * beta
-    b2 = qb - 2.0 * alpha * beta
-    c2 = qc - alpha * alpha
+    a2 = ray.qa - beta * beta
+    b2 = ray.qb - 2.0 * alpha * beta
+    c2 = ray.qc - alpha * alpha
     disc = b2 * b2 - 4.0 * a2 * c2
     sq = torch.sqrt(disc.clamp_min(0.0))
     q = -0.5 * (b2 + torch.where(b2 >= 0, sq, -sq))  # stable: no cancellation between b2 and sq
@@ -112,30 +115,32 @@ def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_
     ray = _Ray(dx * dx + dz * dz, 2 * (oc[:, 0] * dx + oc[:, 2] * dz), oc[:, 0] ** 2 + oc[:, 2] ** 2, oc[:, 1], dy)
     ray_idx, seg = _segment_pairs(ray, h, s_near - s_c, s_far - s_c, n_rows)
     flat = rows.reshape(-1)
-    base = b_idx[ray_idx] * n_rows + seg
-    r_top, r_bot = flat[base], flat[base + 1]
-    hp = h[ray_idx]
+    pair = ray.take(ray_idx)
+    base = b_idx.index_select(0, ray_idx) * n_rows + seg
+    r_top, r_bot = flat.index_select(0, base), flat.index_select(0, base + 1)
+    hp = h.index_select(0, ray_idx)
     y_top = hp * (1 - 2 * seg.to(hp.dtype) / (n_rows - 1))
     y_bot = hp * (1 - 2 * (seg + 1).to(hp.dtype) / (n_rows - 1))
     slope = (r_top - r_bot) / (y_top - y_bot)  # dr/dy of the frustum
-    alpha = r_top + slope * (ray.oy[ray_idx] - y_top)  # frustum radius at t = 0 ...
-    beta = slope * ray.dy[ray_idx]  # ... and its rate along the ray
-    t_lo, t_hi = [(y - ray.oy[ray_idx]) / ray.dy[ray_idx] for y in (y_top, y_bot)]
+    alpha = r_top + slope * (pair.oy - y_top)  # frustum radius at t = 0 ...
+    beta = slope * pair.dy  # ... and its rate along the ray
+    t_lo, t_hi = [(y - pair.oy) / pair.dy for y in (y_top, y_bot)]
     t_lo, t_hi = torch.minimum(t_lo, t_hi), torch.maximum(t_lo, t_hi)
 
-    hits = _hits(ray, ray_idx, alpha, beta, t_lo, t_hi, flat, b_idx, h, n_rows, -s_c)
-    t_min = _minimiser(ray, ray_idx, alpha, beta, t_lo, t_hi, h, flat, b_idx, n_rows)
+    hits = _hits(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, flat, b_idx, h, n_rows, -s_c)
+    t_min = _minimiser(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, hp, flat, b_idx, h, n_rows)
     s_hit = torch.where(hits.hit, hits.s_hit, t_min) + s_c
     return Found(t_min + s_c, s_hit, hits.hit, hits.inner, hits.cap)
 
 
-def _hits(ray, ray_idx, alpha, beta, t_lo, t_hi, flat, b_idx, h, n_rows, t_camera) -> Found:
+def _hits(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, flat, b_idx, h, n_rows, t_camera) -> Found:
     """Entry, mouth and visible point from the frustum quadratics and the two cap planes (t parameters)."""
     m = ray.qa.shape[0]
     inf = float("inf")
     first = []
-    for t in _cone_roots(ray, alpha, beta, ray_idx):
-        ok = (t >= t_lo) & (t <= t_hi) & (t > t_camera[ray_idx])
+    t_cam = t_camera.index_select(0, ray_idx)
+    for t in _cone_roots(pair, alpha, beta):
+        ok = (t >= t_lo) & (t <= t_hi) & (t > t_cam)
         first.append(torch.where(ok, t, torch.full_like(t, inf)))
     t_side = _first(torch.minimum(*first), ray_idx, m)
     caps = []
@@ -153,32 +158,31 @@ def _hits(ray, ray_idx, alpha, beta, t_lo, t_hi, flat, b_idx, h, n_rows, t_camer
     return Found(visible, visible, hit, mouth, on_cap)
 
 
-def _minimiser(ray, ray_idx, alpha, beta, t_lo, t_hi, h, flat, b_idx, n_rows) -> torch.Tensor:
+def _minimiser(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, hp, flat, b_idx, h, n_rows) -> torch.Tensor:
     """argmin_t F along each ray: exact per frustum (convex there) plus the rims' corner candidates."""
     m = ray.qa.shape[0]
-    qa = ray.qa.clamp_min(1e-12)
-    t_axis = -ray.qb / (2 * qa)  # closest approach to the axis
-    m2 = (ray.qc - ray.qb * ray.qb / (4 * qa)).clamp_min(0.0)  # its squared distance
+    qa = pair.qa.clamp_min(1e-12)
+    t_axis = -pair.qb / (2 * qa)  # closest approach to the axis
+    m2 = (pair.qc - pair.qb * pair.qb / (4 * qa)).clamp_min(0.0)  # its squared distance
     # stationary point of rho(t) - (alpha + beta t): qa u / sqrt(qa u^2 + m2) = beta, u = t - t_axis
-    qa_p, m2_p = qa[ray_idx], m2[ray_idx]
-    room = qa_p - beta * beta
-    u = torch.where(room > 0, beta * torch.sqrt(m2_p / (qa_p * room.clamp_min(1e-20))),
-                    torch.sign(beta) * BIG)
-    oy, dy, hp = ray.oy[ray_idx], ray.dy[ray_idx], h[ray_idx]
+    room = qa - beta * beta
+    u = torch.where(room > 0, beta * torch.sqrt(m2 / (qa * room.clamp_min(1e-20))), torch.sign(beta) * BIG)
+    oy, dy = pair.oy, pair.dy
     # where the lateral term meets the cap term of the segment's half (deep hits near the caps)
     side = torch.where(oy + 0.5 * (t_lo + t_hi) * dy >= 0, 1.0, -1.0).to(alpha.dtype)  # sign of y
     # rho - (alpha + beta t) = side * y(t) - h  <=>  rho = (alpha - h + side oy) + (beta + side dy) t
-    crossings = _cone_roots(ray, alpha - hp + side * oy, beta + side * dy, ray_idx)
+    crossings = _cone_roots(pair, alpha - hp + side * oy, beta + side * dy)
     f_best = torch.full_like(ray.qa, float("inf"))
     t_best = torch.zeros_like(f_best)
-    for t in [t_axis[ray_idx] + u] + crossings:
+    for t in [t_axis + u] + crossings:
         t = torch.where(torch.isfinite(t), t, t_lo)
         t = torch.minimum(torch.maximum(t, t_lo), t_hi)
-        f = torch.maximum(ray.rho(t, ray_idx) - (alpha + beta * t), (oy + t * dy).abs() - hp)
+        f = torch.maximum(pair.rho(t) - (alpha + beta * t), (oy + t * dy).abs() - hp)
         f_ray = _first(f, ray_idx, m)
-        sel = (f <= f_ray[ray_idx]) & (f_ray[ray_idx] < f_best[ray_idx])
+        sel = (f <= f_ray.index_select(0, ray_idx)) & (f_ray < f_best).index_select(0, ray_idx)
         t_best = t_best.index_put((ray_idx[sel],), t[sel])
         f_best = torch.minimum(f_best, f_ray)
+    t_axis = -ray.qb / (2 * ray.qa.clamp_min(1e-12))
 
     cand = _rim_candidates(ray, t_axis, h, flat, b_idx, n_rows)  # M x C
     f_cand = _implicit(ray, cand, h, flat, b_idx, n_rows)

@@ -133,9 +133,9 @@ def cast_rays(
     # takes the soft silhouette to exactly 0 at the culling margin, so it stays continuous in every input
     sil_m = torch.sigmoid(-g / sigma) * (CULL_SIGMAS - g / sigma).clamp(0.0, 1.0)
 
-    hit_pts, normals, uv = _surface_at(rays, found, row_slopes(radius, height))
-    cam_pts = (rot[b_idx] @ hit_pts[..., None])[..., 0] + translation(pose, camera)[b_idx]
-    cam_nrm = (rot[b_idx] @ normals[..., None])[..., 0]
+    s_hit, normals, uv = _surface_at(rays, found, row_slopes(radius, height))
+    # the camera sits at the origin: a point at parameter s along pixel p's ray is s * dirs[p] in camera space
+    cam_pts = s_hit[:, None] * dirs.index_select(0, p_idx)
 
     total = n_batch * d_obj.shape[1]
     hit_m = found.hit
@@ -148,7 +148,8 @@ def cast_rays(
     inner = scatter(found.inner & hit_m).view(n_batch, size, size)
     depth = scatter(torch.where(hit_m, cam_pts[:, 2], torch.zeros_like(cam_pts[:, 2]))).view(n_batch, size, size)
     points = scatter(cam_pts).view(n_batch, size, size, 3)
-    normal = scatter(cam_nrm * hit_m[:, None].to(dt)).view(n_batch, size, size, 3)
+    normal = scatter(normals * hit_m[:, None].to(dt)).view(n_batch, -1, 3) @ rot.transpose(1, 2)  # to camera
+    normal = normal.view(n_batch, size, size, 3)
     uv_img = scatter(uv).view(n_batch, size, size, 2)
     return Hits(sil, mask, inner, depth, points, normal, uv_img)
 
@@ -191,7 +192,7 @@ def _span(origin: torch.Tensor, d: torch.Tensor, rb: torch.Tensor, hb: torch.Ten
 
 
 def _surface_at(rays: _Rays, found: Found, slopes: torch.Tensor):
-    """Differentiable hit points (canonical, M x 3), normals of the seen side (M x 3) and uv (M x 2)."""
+    """Differentiable hit parameters along the rays (M), canonical normals of the seen side (M x 3), uv (M x 2)."""
     s0 = found.s_hit
     lateral, cap, _ = rays.field(s0[:, None])
     bottom = found.cap & found.hit
@@ -215,4 +216,4 @@ def _surface_at(rays: _Rays, found: Found, slopes: torch.Tensor):
     up[:, 1] = torch.where(found.inner, 1.0, -1.0)
     normal = torch.where(bottom[:, None], up, side)
     u = torch.atan2(p[:, 0], -p[:, 2]) / math.pi
-    return p, normal, torch.stack([u, v], dim=-1)
+    return s, normal, torch.stack([u, v], dim=-1)
