@@ -81,7 +81,6 @@ class _Phong(torch.autograd.Function):
 
     @staticmethod
     def forward(ctx, n, p, radiance, alpha, dirs):
-        ctx.save_for_backward(n, p, radiance, alpha, dirs)
         step = _chunk(n, dirs)
         rad = radiance[..., None]  # B x E x 1
         diffuse, lobe_sum = [], []
@@ -90,24 +89,26 @@ class _Phong(torch.autograd.Function):
             diffuse.append((ln @ rad)[..., 0])
             lobe_sum.append((lobe @ rad)[..., 0])
         norm = (alpha[:, None] + 1) / (2 * math.pi)
-        return torch.cat(diffuse, 1), norm * torch.cat(lobe_sum, 1)
+        lobe_sum = torch.cat(lobe_sum, 1)  # B x N, kept: d I_s / d alpha needs it
+        ctx.save_for_backward(n, p, radiance, alpha, dirs, lobe_sum)
+        return torch.cat(diffuse, 1), norm * lobe_sum
 
     @staticmethod
     def backward(ctx, g_diffuse, g_specular):
-        n, p, radiance, alpha, dirs = ctx.saved_tensors
+        n, p, radiance, alpha, dirs, lobe_sum = ctx.saved_tensors
         step = _chunk(n, dirs)
         norm = (alpha + 1) / (2 * math.pi)  # B
         rad = radiance[..., None]  # B x E x 1
         g_n, g_p = torch.zeros_like(n), torch.zeros_like(p)
-        g_rad, g_alpha = torch.zeros_like(radiance), torch.zeros_like(alpha)
+        g_rad = torch.zeros_like(radiance)
+        g_alpha = (g_specular * lobe_sum).sum(1) / (2 * math.pi)  # from the normalisation (alpha + 1) / (2 pi)
         for i in range(0, n.shape[1], step):
             sl = slice(i, i + step)
             ln, rp, log_rp, lobe = _phong_chunk(n[:, sl], p[:, sl], dirs, alpha)
             gd = g_diffuse[:, sl, None]  # B x n x 1
             gs = g_specular[:, sl, None] * norm[:, None, None]
             g_rad += (ln.transpose(1, 2) @ gd + lobe.transpose(1, 2) @ gs)[..., 0]
-            # I_s = norm * sum lobe rad: d/d alpha = sum lobe rad / (2 pi) + norm * sum lobe log(rp) rad
-            g_alpha += (g_specular[:, sl, None] * (lobe @ rad)).sum((1, 2)) / (2 * math.pi)
+            # ... and from the lobe: norm * sum lobe log(rp) rad
             g_alpha += (gs * ((lobe * log_rp) @ rad)).sum((1, 2))
             # d lobe / d rp = alpha rp^(alpha - 1) where the light counts; d diffuse / d ln = rad where lit
             g_rp = (lobe / rp.clamp_min(TINY)).masked_fill_(lobe <= 1e-26, 0.0) * radiance[:, None, :]
