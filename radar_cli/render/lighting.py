@@ -57,6 +57,8 @@ def shading_factors(
 
 
 CHUNK_ELEMENTS = 1 << 22  # B x samples x lights per chunk: bounds the B x N x E intermediates (16 MiB in float32)
+KEEP_ELEMENTS = 1 << 25  # up to this B x N x E the forward's chunks are kept for backward (4 x 128 MiB in float32)
+# instead of recomputed; larger problems (64 x 64 grids at batch 24) recompute to keep memory flat
 
 
 def _phong_chunk(n: torch.Tensor, p: torch.Tensor, dirs: torch.Tensor, alpha: torch.Tensor):
@@ -83,11 +85,15 @@ class _Phong(torch.autograd.Function):
     def forward(ctx, n, p, radiance, alpha, dirs):
         step = _chunk(n, dirs)
         rad = radiance[..., None]  # B x E x 1
-        diffuse, lobe_sum = [], []
+        keep = n.shape[0] * n.shape[1] * dirs.shape[0] <= KEEP_ELEMENTS
+        diffuse, lobe_sum, ctx.chunks = [], [], []
         for i in range(0, n.shape[1], step):
-            ln, _, _, lobe = _phong_chunk(n[:, i : i + step], p[:, i : i + step], dirs, alpha)
+            chunk = _phong_chunk(n[:, i : i + step], p[:, i : i + step], dirs, alpha)
+            ln, lobe = chunk[0], chunk[3]
             diffuse.append((ln @ rad)[..., 0])
             lobe_sum.append((lobe @ rad)[..., 0])
+            if keep and any(ctx.needs_input_grad):
+                ctx.chunks.append(chunk)
         norm = (alpha[:, None] + 1) / (2 * math.pi)
         lobe_sum = torch.cat(lobe_sum, 1)  # B x N, kept: d I_s / d alpha needs it
         ctx.save_for_backward(n, p, radiance, alpha, dirs, lobe_sum)
@@ -104,7 +110,8 @@ class _Phong(torch.autograd.Function):
         g_alpha = (g_specular * lobe_sum).sum(1) / (2 * math.pi)  # from the normalisation (alpha + 1) / (2 pi)
         for i in range(0, n.shape[1], step):
             sl = slice(i, i + step)
-            ln, rp, log_rp, lobe = _phong_chunk(n[:, sl], p[:, sl], dirs, alpha)
+            chunk = ctx.chunks[i // step] if ctx.chunks else _phong_chunk(n[:, sl], p[:, sl], dirs, alpha)
+            ln, rp, log_rp, lobe = chunk
             gd = g_diffuse[:, sl, None]  # B x n x 1
             gs = g_specular[:, sl, None] * norm[:, None, None]
             g_rad += (ln.transpose(1, 2) @ gd + lobe.transpose(1, 2) @ gs)[..., 0]
@@ -120,6 +127,7 @@ class _Phong(torch.autograd.Function):
             gm_n = (g_mirror * nk).sum(-1, keepdim=True)
             g_n[:, sl] = g_ln @ dirs + 2 * (np_ * g_mirror + gm_n * pk)
             g_p[:, sl] = 2 * gm_n * nk - g_mirror
+        ctx.chunks = []  # release the kept intermediates
         return g_n, g_p, g_rad, g_alpha, None
 
 
