@@ -30,3 +30,18 @@ def render(device: str, sizes: str, batch: int, repeats: int, threads: int) -> N
     except ValueError:
         raise InputError(f"--sizes: expected comma-separated integers, got {sizes!r}") from None
     click.echo(json.dumps(run_benchmark(size_list, batch, device, repeats, threads), indent=2))
+
+
+@bench.command("train")
+@click.option("--config", "config_path", default="pipelines/syn_vases_cpu.toml", show_default=True,
+              type=click.Path(dir_okay=False), help="Preset TOML to time.")
+@click.option("--device", default="auto", show_default=True, type=click.Choice(["cpu", "cuda", "auto"]))
+@click.option("--steps", default=5, show_default=True, type=click.IntRange(min=1), help="Timed steps (median).")
+@click.option("--warmup", default=2, show_default=True, type=click.IntRange(min=0), help="Untimed first steps.")
+@click.option("--batch", default=None, type=click.IntRange(min=1), help="Batch size (default: the preset's).")
+@click.option("--threads", default=None, type=click.IntRange(min=1), help="CPU threads (default: the preset's).")
+def train(config_path: str, device: str, steps: int, warmup: int, batch: int | None, threads: int | None) -> None:
+    """Seconds per full training step (model + discriminator, forward, backward, Adam) and peak memory."""
+    from radar_cli.train.benchmark import bench_train
+
+    click.echo(json.dumps(bench_train(config_path, steps, warmup, batch, device, threads), indent=2))

@@ -64,3 +64,13 @@ def test_loss_curve_draws_every_term():
     assert image.shape == (500, 900, 3) and image.dtype == np.uint8
     assert (image != 255).any(axis=2).sum() > 500  # lines and labels were drawn
     assert loss_curve([]).shape == (500, 900, 3)
+
+
+def test_bench_train_command_prints_json():
+    import json
+
+    result = CliRunner().invoke(cli, ["bench", "train", "--config", str(PRESET), "--device", "cpu", "--steps", "1",
+                                      "--warmup", "0", "--batch", "2", "--threads", "1"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.output)
+    assert out["preset"] == "syn_vases_cpu" and out["batch_size"] == 2 and out["sec_per_step"] > 0
