@@ -14,7 +14,7 @@ from pathlib import Path
 
 import torch
 
-from radar_cli.errors import RadarError
+from radar_cli.errors import InputError, RadarError
 from radar_cli.model.config import RunConfig
 from radar_cli.model.discriminator import PatchDiscriminator
 from radar_cli.model.losses import sad_discriminator_loss
@@ -68,12 +68,15 @@ def uses_sad(config: RunConfig) -> bool:
     return not config.loss.no_sad and not config.loss.supervised
 
 
-def _finite_or_stop(value: torch.Tensor, what: str, step: int, info: D.DistInfo, run_dir: Path) -> None:
-    if D.all_finite(value, info):
-        return
+def _diverged(step: int, what: str, run_dir: Path) -> DivergedError:
     ckpts = list_checkpoints(run_dir)
     last = f"last good checkpoint: {ckpts[-1]}" if ckpts else "no checkpoint was written yet"
-    raise DivergedError(f"step {step}: {what} is NaN or Inf; stopped before the update ({last})")
+    return DivergedError(f"step {step}: {what}; stopped before the update ({last})")
+
+
+def _finite_or_stop(value: torch.Tensor, what: str, step: int, info: D.DistInfo, run_dir: Path) -> None:
+    if not D.all_finite(value, info):
+        raise _diverged(step, f"{what} is NaN or Inf", run_dir)
 
 
 def train_step(state: TrainState, model: torch.nn.Module, disc: torch.nn.Module, batch: Batch, config: RunConfig,
@@ -81,7 +84,10 @@ def train_step(state: TrainState, model: torch.nn.Module, disc: torch.nn.Module,
     """One optimisation step of the model and, with L_SAD, of D. `model`/`disc` may be DDP wrappers of
     state.model/state.disc. Returns (loss terms as floats, prediction, rendered) of this rank's batch."""
     step = state.step
-    pred = model(batch.image)
+    try:
+        pred = model(batch.image)
+    except InputError as e:  # the geometry checks inside forward reject NaN shapes before we see them
+        raise _diverged(step, f"invalid network output ({e})", run_dir) from None
     _finite_or_stop(torch.stack([t.sum() for t in pred.as_tuple()]), "a network output", step, info, run_dir)
     bare_disc = D.unwrap(disc)
     terms, rendered = generator_losses(pred, batch, config, bare_disc if uses_sad(config) else None)

@@ -85,3 +85,18 @@ def test_overfit_one_sample_drives_reconstruction_near_zero(vases32, tmp_path):
     first, last = summary.history[0], summary.history[-1]
     assert last["im"] < 0.03 and last["im"] < 0.25 * first["im"]
     assert last["sil"] < 0.7 * first["sil"]  # the soft silhouette's blur sets a floor at 32 px
+
+
+def test_nan_weights_stop_with_step(vases32, tmp_path, monkeypatch):
+    real = trainer.train_step
+
+    def poison_then_step(state, model, disc, batch, config, info, run_dir):
+        if state.step == 1:
+            with torch.no_grad():
+                for p in state.model.shape_net.parameters():
+                    p.fill_(float("nan"))
+        return real(state, model, disc, batch, config, info, run_dir)
+
+    monkeypatch.setattr(trainer, "train_step", poison_then_step)
+    with pytest.raises(DivergedError, match="step 1: invalid network output"):
+        train(tiny_config(iterations=3), vases32, tmp_path / "run", progress=False)
