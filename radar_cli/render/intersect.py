@@ -94,7 +94,7 @@ def _first(values: torch.Tensor, ray_idx: torch.Tensor, m: int) -> torch.Tensor:
 
 @torch.no_grad()
 def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_idx: torch.Tensor,
-           h: torch.Tensor, s_near: torch.Tensor, s_far: torch.Tensor) -> Found:
+           h: torch.Tensor, s_near: torch.Tensor, s_far: torch.Tensor, deep: float = float("inf")) -> Found:
     """Exact first hits, mouth exits and minimisers of F = max(rho - r(y), |y| - h) along M rays.
 
     Args:
@@ -103,6 +103,8 @@ def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_
         b_idx: M batch index of each ray.
         h: M half-heights in object-space units.
         s_near, s_far: M span of each ray inside the (inflated) bounding cylinder.
+        deep: rays whose chord through the solid has F < -deep at its middle skip the exact minimisation of F
+            (their soft silhouette is saturated): s_min is that middle point instead.
 
     Returns:
         Found (all M).
@@ -128,13 +130,22 @@ def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_
     t_lo, t_hi = torch.minimum(t_lo, t_hi), torch.maximum(t_lo, t_hi)
 
     hits = _hits(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, flat, b_idx, h, n_rows, -s_c)
-    t_min = _minimiser(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, hp, flat, b_idx, h, n_rows)
+    mid = hits.s_min
+    inside = hits.hit & (_implicit(ray, mid[:, None], h, flat, b_idx, n_rows)[:, 0] < -deep)
+    keep = ~inside.index_select(0, ray_idx)
+    if not bool(keep.all()):
+        pair = _Ray(*(x[keep] for x in (pair.qa, pair.qb, pair.qc, pair.oy, pair.dy)))
+        ray_idx, alpha, beta, t_lo, t_hi, hp = (x[keep] for x in (ray_idx, alpha, beta, t_lo, t_hi, hp))
+    t_min = _minimiser(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, hp, flat, b_idx, h, n_rows,
+                       (~inside).nonzero()[:, 0])
+    t_min = torch.where(inside, mid, t_min)
     s_hit = torch.where(hits.hit, hits.s_hit, t_min) + s_c
     return Found(t_min + s_c, s_hit, hits.hit, hits.inner, hits.cap)
 
 
 def _hits(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, flat, b_idx, h, n_rows, t_camera) -> Found:
-    """Entry, mouth and visible point from the frustum quadratics and the two cap planes (t parameters)."""
+    """Entry, mouth and visible point from the frustum quadratics and the two cap planes (t parameters); s_min holds
+    the middle of the first chord through the solid (the entry where there is none)."""
     m = ray.qa.shape[0]
     inf = float("inf")
     first = []
@@ -142,7 +153,8 @@ def _hits(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, flat, b_idx, h, n_rows, t
     for t in _cone_roots(pair, alpha, beta):
         ok = (t >= t_lo) & (t <= t_hi) & (t > t_cam)
         first.append(torch.where(ok, t, torch.full_like(t, inf)))
-    t_side = _first(torch.minimum(*first), ray_idx, m)
+    nearest = torch.minimum(*first)
+    t_side = _first(nearest, ray_idx, m)
     caps = []
     for y_cap, r_cap in ((h, flat[b_idx * n_rows]), (-h, flat[b_idx * n_rows + n_rows - 1])):
         t = (y_cap - ray.oy) / ray.dy
@@ -155,10 +167,16 @@ def _hits(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, flat, b_idx, h, n_rows, t
     mouth = hit & (t_top < t_other) & torch.isfinite(t_other)
     visible = torch.where(mouth, t_other, entry)
     on_cap = hit & (visible == t_bottom) & (t_bottom < t_side)
-    return Found(visible, visible, hit, mouth, on_cap)
+    # the next crossing after the entry closes the first chord through the solid; its middle is deep inside
+    after = entry.index_select(0, ray_idx)
+    t_next = _first(torch.minimum(*[torch.where(t > after, t, torch.full_like(t, inf)) for t in first]), ray_idx, m)
+    for t in caps:
+        t_next = torch.minimum(t_next, torch.where(t > entry, t, torch.full_like(t, inf)))
+    mid = torch.where(hit & torch.isfinite(t_next), 0.5 * (entry + t_next), entry)
+    return Found(mid, visible, hit, mouth, on_cap)
 
 
-def _minimiser(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, hp, flat, b_idx, h, n_rows) -> torch.Tensor:
+def _minimiser(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, hp, flat, b_idx, h, n_rows, idx) -> torch.Tensor:
     """argmin_t F along each ray: exact per frustum (convex there) plus the rims' corner candidates."""
     m = ray.qa.shape[0]
     qa = pair.qa.clamp_min(1e-12)
@@ -182,13 +200,15 @@ def _minimiser(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, hp, flat, b_idx, h, 
         sel = (f <= f_ray.index_select(0, ray_idx)) & (f_ray < f_best).index_select(0, ray_idx)
         t_best = t_best.index_put((ray_idx[sel],), t[sel])
         f_best = torch.minimum(f_best, f_ray)
-    t_axis = -ray.qb / (2 * ray.qa.clamp_min(1e-12))
-
-    cand = _rim_candidates(ray, t_axis, h, flat, b_idx, n_rows)  # M x C
-    f_cand = _implicit(ray, cand, h, flat, b_idx, n_rows)
+    # the rims' candidates, for the rays that still need an exact minimum (idx)
+    sub, h_s, b_s = ray.take(idx), h.index_select(0, idx), b_idx.index_select(0, idx)
+    t_axis = -sub.qb / (2 * sub.qa.clamp_min(1e-12))
+    cand = _rim_candidates(sub, t_axis, h_s, flat, b_s, n_rows)  # M' x C
+    f_cand = _implicit(sub, cand, h_s, flat, b_s, n_rows)
     k = f_cand.argmin(1, keepdim=True)
-    better = f_cand.gather(1, k)[:, 0] < f_best
-    return torch.where(better, cand.gather(1, k)[:, 0], t_best)
+    f_rim, t_rim = f_cand.gather(1, k)[:, 0], cand.gather(1, k)[:, 0]
+    better = f_rim < f_best.index_select(0, idx)
+    return t_best.index_put((idx[better],), t_rim[better])
 
 
 def _rim_candidates(ray, t_axis, h, flat, b_idx, n_rows) -> torch.Tensor:

@@ -24,6 +24,7 @@ from radar_cli.render.intersect import Found, search
 from radar_cli.sor.profile import check_sor, row_coordinate, row_slopes
 
 CULL_SIGMAS = 6.0  # rays farther than this many sigmas from the bounding cylinder are not cast (sil = 0)
+DEEP_SIGMAS = 10.0  # hits this many sigmas inside skip the exact margin (sil > 0.99995 either way)
 
 
 @dataclass(frozen=True)
@@ -127,7 +128,7 @@ def cast_rays(
     flat = b_idx * d_obj.shape[1] + p_idx
 
     found = search(rays.o.detach(), rays.d.detach(), r_world.detach(), b_idx, rays.h.detach(),
-                   s_near[b_idx, p_idx], s_far[b_idx, p_idx])
+                   s_near[b_idx, p_idx], s_far[b_idx, p_idx], deep=DEEP_SIGMAS * sigma)
     g = _margin(rays, found.s_min)  # differentiable margin, world units
     # g is close to the distance from the ray to the solid, ~ pixels * pixel size at the object; the taper
     # takes the soft silhouette to exactly 0 at the culling margin, so it stays continuous in every input
