@@ -24,6 +24,9 @@ from radar_cli.derender.predictor import Predictor
 @click.option("--crop", type=click.Choice(["auto", "none"]), default="auto", show_default=True,
               help="auto: locate the object and crop around it as `radar masks` does (dataset samples are "
                    "crops already); none: pad the whole photo to a square.")
+@click.option("--backdrop", type=click.Choice(["white", "keep"]), default="white", show_default=True,
+              help="white: put the object on white through its silhouette (found by --crop auto, --masks or a "
+                   "dataset's mask.png) before the network, as synthetic training images are; keep: as photographed.")
 @click.option("--device", default="auto", show_default=True, help="auto, cpu, cuda or cuda:N.")
 @click.option("--views", type=click.IntRange(0, 360), default=8, show_default=True, help="Turntable frames.")
 @click.option("--view-size", type=click.IntRange(16, 1024), default=128, show_default=True,
@@ -39,12 +42,12 @@ from radar_cli.derender.predictor import Predictor
 @click.option("--contact-sheet", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Also write a contact sheet PNG (input, reconstruction, albedo, relit view per object).")
 def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks: Path | None, crop: str,
-             device: str, views: int, view_size: int, envs: tuple[Path, ...], batch_size: int, workers: int,
-             threads: int, overwrite: bool, contact_sheet: Path | None) -> None:
+             backdrop: str, device: str, views: int, view_size: int, envs: tuple[Path, ...], batch_size: int,
+             workers: int, threads: int, overwrite: bool, contact_sheet: Path | None) -> None:
     """De-render INPUTS (image files, folders, prepared dataset folders) into --out."""
     predictor = Predictor.from_checkpoint(checkpoint, device)
-    options = DerenderOptions(out=out, crop=crop, masks=masks, envs=envs,  # type: ignore[arg-type]
-                              batch_size=batch_size, workers=workers, threads=threads, overwrite=overwrite,
+    options = DerenderOptions(out=out, crop=crop, backdrop=backdrop, masks=masks,  # type: ignore[arg-type]
+                              envs=envs, batch_size=batch_size, workers=workers, threads=threads, overwrite=overwrite,
                               export=ExportConfig(views, view_size))
     summary = run_derender(list(inputs), predictor, options, say=lambda line: click.echo(line, err=True))
     if contact_sheet is not None and (summary.done or summary.skipped):

@@ -19,7 +19,7 @@ from tqdm import tqdm
 
 from radar_cli.derender.environments import builtin_environments, env_name, load_environment
 from radar_cli.derender.export import ExportConfig, export_object, is_complete
-from radar_cli.derender.inputs import CropMode, Failure, InputItem, Prepared, collect_inputs, prepare
+from radar_cli.derender.inputs import Backdrop, CropMode, Failure, InputItem, Prepared, collect_inputs, prepare
 from radar_cli.derender.predictor import Predictor
 from radar_cli.derender.report import write_report
 from radar_cli.errors import InputError, RadarError
@@ -36,6 +36,7 @@ class DerenderOptions:
 
     out: Path
     crop: CropMode = "auto"
+    backdrop: Backdrop = "white"
     masks: Path | None = None
     envs: tuple[Path, ...] = ()
     batch_size: int = 8
@@ -84,18 +85,17 @@ def environments(paths: tuple[Path, ...], height: int, width: int) -> dict[str, 
     return envs
 
 
-def _prepare_all(items: list[InputItem], size: int, crop: CropMode,
-                 workers: int) -> list[Prepared | Failure]:
+def _prepare_all(items: list[InputItem], size: int, options: DerenderOptions) -> list[Prepared | Failure]:
     """Read and crop a batch of inputs (threads: decoding and detection release the GIL)."""
     def one(item: InputItem) -> Prepared | Failure:
         try:
-            return prepare(item, size, crop)
+            return prepare(item, size, options.crop, options.backdrop)
         except RadarError as e:
             return Failure(str(item.image_path), str(e).removeprefix(f"{item.image_path}: "))
 
-    if workers <= 1:
+    if options.workers <= 1:
         return [one(item) for item in items]
-    with ThreadPoolExecutor(max_workers=workers) as pool:
+    with ThreadPoolExecutor(max_workers=options.workers) as pool:
         return list(pool.map(one, items))
 
 
@@ -149,7 +149,7 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
 def _run_batch(chunk: list[InputItem], predictor: Predictor, options: DerenderOptions,
                envs: dict[str, np.ndarray], summary: BatchSummary, say: Callable[[str], None]) -> None:
     """Crop, predict and export one batch; failures are recorded item by item."""
-    prepared = _prepare_all(chunk, predictor.setup.image_size, options.crop, options.workers)
+    prepared = _prepare_all(chunk, predictor.setup.image_size, options)
     ok = []
     for item, prep in zip(chunk, prepared):
         if isinstance(prep, Failure):

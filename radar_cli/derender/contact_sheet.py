@@ -12,7 +12,7 @@ from radar_cli.derender.renders import relit_file
 from radar_cli.derender.report import read_records
 from radar_cli.errors import InputError
 from radar_cli.fileio import write_image
-from radar_cli.results import ALBEDO_RENDERED_FILE, INPUT_FILE, RECON_FILE
+from radar_cli.results import ALBEDO_RENDERED_FILE, INPUT_FILE, MASK_FILE, RECON_FILE
 
 TILE = 160
 LABEL_H = 16
@@ -20,11 +20,16 @@ NAME_W = 150
 MAX_ROWS = 500
 
 
-def _tile(path: Path) -> Image.Image:
-    """An image resized to TILE x TILE (grey if missing)."""
+def _tile(path: Path, matte: Path | None = None) -> Image.Image:
+    """An image resized to TILE x TILE (grey if missing); with a matte (L mask), put on white outside it."""
     try:
         with Image.open(path) as im:
-            return im.convert("RGB").resize((TILE, TILE), Image.Resampling.BILINEAR)
+            tile = im.convert("RGB").resize((TILE, TILE), Image.Resampling.BILINEAR)
+        if matte is not None:
+            with Image.open(matte) as m:
+                alpha = m.convert("L").resize((TILE, TILE), Image.Resampling.BILINEAR)
+            tile = Image.composite(tile, Image.new("RGB", tile.size, (255, 255, 255)), alpha)
+        return tile
     except (OSError, ValueError):
         return Image.new("RGB", (TILE, TILE), (200, 200, 200))
 
@@ -56,6 +61,7 @@ def contact_sheet(root: str | Path, out: str | Path, env: str = "studio") -> Pat
         y = LABEL_H + r * TILE
         draw.text((4, y + TILE // 2), name[:24], fill=(0, 0, 0))
         for c, (file, _) in enumerate(columns):
-            sheet.paste(_tile(root / name / file), (NAME_W + c * TILE, y))
+            matte = root / name / MASK_FILE if file == ALBEDO_RENDERED_FILE else None  # drawn on black for eval
+            sheet.paste(_tile(root / name / file, matte), (NAME_W + c * TILE, y))
     write_image(out, np.asarray(sheet))
     return Path(out)

@@ -62,6 +62,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomp
         "source": str(item.image_path),
         "crop_box": prepared.crop.to_list(),
         "photo_size": list(prepared.photo_size),
+        "backdrop": prepared.backdrop,
         "image_size": setup.image_size,
         "model": version,
         "environments": sorted(envs),

@@ -17,6 +17,7 @@ from radar_cli.masks.crop import CropBox, cut, mask_box, square_box
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".webp", ".tif", ".tiff")
 CropMode = Literal["auto", "none"]
+Backdrop = Literal["keep", "white"]
 
 
 @dataclass(frozen=True)
@@ -26,7 +27,7 @@ class InputItem:
     Attributes:
         name: the object's folder name under RESULTS (unique within a run, [A-Za-z0-9._-]).
         image_path: the photo.
-        mask_path: a known silhouette (--masks), used to crop; None if unknown.
+        mask_path: a known silhouette (--masks or the dataset sample's), used to crop; None if unknown.
         is_crop: the image is already a network crop (a prepared dataset sample): used whole.
     """
 
@@ -55,11 +56,13 @@ class Prepared:
         image: S x S x 3 uint8 RGB crop (S = the model's image size).
         crop: the square window of the original photo the crop shows (x0, y0, side in its pixels).
         photo_size: (width, height) of the original photo after EXIF orientation.
+        backdrop: `white` if the backdrop was replaced by white, else `kept`.
     """
 
     image: np.ndarray
     crop: CropBox
     photo_size: tuple[int, int]
+    backdrop: str = "kept"
 
 
 def _is_image(path: Path) -> bool:
@@ -75,11 +78,11 @@ def _folder_items(folder: Path, masks: Path | None) -> list[InputItem]:
     samples = sorted(folder.glob(f"*/*/{IMAGE_FILE}")) if is_dataset(folder) else []
     if samples:
         several = len({p.parent.parent.name for p in samples}) > 1
-        return [InputItem(f"{p.parent.parent.name}_{p.parent.name}" if several else p.parent.name, p, is_crop=True)
-                for p in samples]
+        return [InputItem(f"{p.parent.parent.name}_{p.parent.name}" if several else p.parent.name, p,
+                          _existing(p.parent / MASK_FILE), is_crop=True) for p in samples]
     samples = sorted(folder.glob(f"*/{IMAGE_FILE}"))
     if samples:
-        return [InputItem(p.parent.name, p, is_crop=True) for p in samples]
+        return [InputItem(p.parent.name, p, _existing(p.parent / MASK_FILE), is_crop=True) for p in samples]
     images = sorted(p for p in folder.rglob("*") if p.is_file() and _is_image(p))
     return [InputItem(p.stem, p, _mask_for(p, masks)) for p in images]
 
@@ -157,7 +160,7 @@ def _unique(found: list[InputItem], failures: list[Failure]) -> list[InputItem]:
     return items
 
 
-def locate(photo: np.ndarray, size: int, name: str) -> tuple[np.ndarray, CropBox]:
+def locate(photo: np.ndarray, size: int, name: str) -> tuple[np.ndarray, CropBox, np.ndarray]:
     """The object's square crop, cut exactly as `radar masks` cuts its training crops (detect, GrabCut, frame).
 
     Args:
@@ -166,7 +169,7 @@ def locate(photo: np.ndarray, size: int, name: str) -> tuple[np.ndarray, CropBox
         name: the file, for messages.
 
     Returns:
-        (S x S x 3 uint8 crop, its window in the photo).
+        (S x S x 3 uint8 crop, its window in the photo, S x S bool silhouette).
     """
     from radar_cli.masks.detect import detect
     from radar_cli.masks.pipeline import Settings, check_photo, crop_detection
@@ -176,7 +179,7 @@ def locate(photo: np.ndarray, size: int, name: str) -> tuple[np.ndarray, CropBox
     if not found:
         raise InputError(f"{name}: no object stands out from the backdrop; crop it square or use --crop none")
     crop = crop_detection(photo, found[0], Settings(size=size))
-    return crop.image, crop.box
+    return crop.image, crop.box, crop.mask
 
 
 def whole_photo(photo: np.ndarray) -> CropBox:
@@ -186,7 +189,27 @@ def whole_photo(photo: np.ndarray) -> CropBox:
     return CropBox((w - side) // 2, (h - side) // 2, side)
 
 
-def prepare(item: InputItem, size: int, crop: CropMode = "auto") -> Prepared:
+def white_backdrop(image: np.ndarray, silhouette: np.ndarray) -> np.ndarray:
+    """Put the object of an S x S x 3 uint8 crop on white, through its S x S silhouette; the edge is feathered
+    outwards only (~1 px), so the object's own pixels are unchanged."""
+    import cv2
+
+    sil = silhouette.astype(np.float32)
+    alpha = np.maximum(sil, cv2.GaussianBlur(sil, (0, 0), max(0.5, image.shape[0] / 256)))[..., None]
+    return (image * alpha + 255.0 * (1.0 - alpha) + 0.5).astype(np.uint8)
+
+
+def _known_mask(item: InputItem, shape: tuple[int, int]) -> np.ndarray | None:
+    """The item's silhouette (H x W bool) from --masks or its dataset sample, checked against the photo."""
+    if item.mask_path is None:
+        return None
+    mask = read_image(item.mask_path, "L") > 127
+    if mask.shape != shape or not mask.any():
+        raise InputError(f"{item.mask_path}: mask is empty or its size {mask.shape} is not the photo's {shape}")
+    return mask
+
+
+def prepare(item: InputItem, size: int, crop: CropMode = "auto", backdrop: Backdrop = "white") -> Prepared:
     """Read a photo and cut the network's input.
 
     `auto` locates the object and crops around it (from the --masks silhouette if given, else as `radar masks`
@@ -196,21 +219,21 @@ def prepare(item: InputItem, size: int, crop: CropMode = "auto") -> Prepared:
         item: the input.
         size: S, the model's image side.
         crop: `auto` or `none`.
+        backdrop: `white` puts the object on white through its silhouette (as synthetic training images are);
+            `keep` leaves the photo's backdrop. Without a silhouette (`--crop none`, no mask) it is kept.
 
     Returns:
         Prepared; InputError names the file on any problem.
     """
     photo = read_image(item.image_path, "RGB")
     h, w = photo.shape[:2]
-    if item.is_crop or crop == "none":
-        box = whole_photo(photo)
-        return Prepared(cut(photo, box, size), box, (w, h))
-    if item.mask_path is None:
-        image, box = locate(photo, size, str(item.image_path))
-        return Prepared(image, box, (w, h))
-    mask = read_image(item.mask_path, "L") > 127
-    bounds = mask_box(mask) if mask.shape == (h, w) else None
-    if bounds is None:
-        raise InputError(f"{item.mask_path}: mask is empty or its size {mask.shape} is not the photo's {(h, w)}")
-    box = square_box(bounds)
-    return Prepared(cut(photo, box, size), box, (w, h))
+    mask = _known_mask(item, (h, w))
+    if mask is None and not item.is_crop and crop == "auto":
+        image, box, silhouette = locate(photo, size, str(item.image_path))
+    else:
+        box = whole_photo(photo) if item.is_crop or crop == "none" else square_box(mask_box(mask))  # type: ignore
+        image = cut(photo, box, size)
+        silhouette = None if mask is None else cut(mask.astype(np.uint8) * 255, box, size) > 127
+    if backdrop == "white" and silhouette is not None:
+        return Prepared(white_backdrop(image, silhouette), box, (w, h), "white")
+    return Prepared(np.ascontiguousarray(image), box, (w, h))

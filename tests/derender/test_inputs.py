@@ -90,3 +90,16 @@ def test_results_inside_an_input_folder_are_not_inputs(tmp_path: Path) -> None:
     write_photo(tmp_path / "photos" / "results" / "a" / "recon.png", 2)
     items, _ = collect_inputs([tmp_path / "photos"], exclude=tmp_path / "photos" / "results")
     assert [i.image_path.name for i in items] == ["a.png"]
+
+
+def test_white_backdrop_through_the_silhouette(tmp_path: Path) -> None:
+    photo = vase_photo(5, (96, 144))
+    photo[..., 1] = np.where(photo[..., 1] == 225, 150, photo[..., 1])  # a greenish-grey studio backdrop
+    path = tmp_path / "p.png"
+    Image.fromarray(photo).save(path)
+    (item,), _ = collect_inputs([path])
+    kept, white = prepare(item, SIZE, backdrop="keep"), prepare(item, SIZE, backdrop="white")
+    assert kept.backdrop == "kept" and white.backdrop == "white"
+    assert tuple(kept.image[1, 1]) == (225, 150, 225) and tuple(white.image[1, 1]) == (255, 255, 255)
+    centre = (slice(SIZE // 2 - 4, SIZE // 2 + 4),) * 2
+    np.testing.assert_array_equal(white.image[centre], kept.image[centre])  # the object itself is untouched
