@@ -1,4 +1,4 @@
-"""`radar bench`: speed and memory benchmarks, one subcommand per stage (render; train, masks, derender later)."""
+"""`radar bench`: speed and memory benchmarks, one subcommand per stage (render, train, masks, derender)."""
 
 from __future__ import annotations
 
@@ -45,3 +45,32 @@ def train(config_path: str, device: str, steps: int, warmup: int, batch: int | N
     from radar_cli.train.benchmark import bench_train
 
     click.echo(json.dumps(bench_train(config_path, steps, warmup, batch, device, threads), indent=2))
+
+
+@bench.command("masks")
+@click.option("--photos", default=12, show_default=True, type=click.IntRange(min=1), help="Generated studio photos.")
+@click.option("--long-side", default=4000, show_default=True, type=click.IntRange(min=64),
+              help="Long edge of each photo in pixels.")
+@click.option("--size", default=256, show_default=True, type=click.IntRange(min=16), help="Crop side in pixels.")
+@click.option("--workers", default=2, show_default=True, type=click.IntRange(min=1))
+def masks(photos: int, long_side: int, size: int, workers: int) -> None:
+    """Photos per second through `radar masks` (decode, detect, GrabCut, crop, score, write)."""
+    from radar_cli.masks.benchmark import bench_masks
+
+    click.echo(json.dumps(bench_masks(photos, long_side, size, workers), indent=2))
+
+
+@bench.command("derender")
+@click.option("--checkpoint", default=None, type=click.Path(dir_okay=False), help="Default: the bundled model.")
+@click.option("--device", default="cpu", show_default=True, help="auto, cpu, cuda or cuda:N.")
+@click.option("--images", default=32, show_default=True, type=click.IntRange(min=1),
+              help="Images through the network alone.")
+@click.option("--exports", default=4, show_default=True, type=click.IntRange(min=1),
+              help="Images de-rendered end to end with every export.")
+@click.option("--batch-size", default=8, show_default=True, type=click.IntRange(min=1))
+@click.option("--threads", default=1, show_default=True, type=click.IntRange(min=1), help="torch threads.")
+def derender(checkpoint: str | None, device: str, images: int, exports: int, batch_size: int, threads: int) -> None:
+    """Images per second for the network alone and for the full de-rendering with all exports."""
+    from radar_cli.derender.benchmark import bench_derender
+
+    click.echo(json.dumps(bench_derender(checkpoint, device, images, exports, batch_size, threads), indent=2))

@@ -25,3 +25,15 @@ def test_bench_render_rejects_bad_sizes():
     assert result.exit_code == 2 and "--sizes" in result.output
     result = CliRunner().invoke(cli, ["bench", "render", "--device", "cpu", "--sizes", "4"])
     assert result.exit_code == 2 and "--sizes" in result.output
+
+
+def test_bench_masks_and_derender_print_json():
+    result = CliRunner().invoke(cli, ["bench", "masks", "--photos", "1", "--long-side", "400", "--size", "64",
+                                      "--workers", "1"])
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.output)
+    assert report["photos"] == 1 and report["photos_per_second"] > 0
+    result = CliRunner().invoke(cli, ["bench", "derender", "--images", "2", "--exports", "1", "--batch-size", "2"])
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.output)
+    assert report["network_images_per_s"] > 0 and report["full_images_per_s"] > 0 and report["failed"] == 0
