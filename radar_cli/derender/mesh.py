@@ -1,5 +1,6 @@
 """Textured meshes of one object: mesh.glb (PBR material: 360 deg albedo, roughness from the shininess) and
-mesh.obj + .mtl + texture, via trimesh, in the canonical object frame (axis = +y, the seen side facing -z)."""
+mesh.obj + .mtl + texture, via trimesh: axis = +y, the photographed side facing +z (the glTF/OBJ viewers' default
+front), i.e. the canonical object frame turned 180 deg about the axis."""
 
 from __future__ import annotations
 
@@ -16,6 +17,8 @@ from radar_cli.render.lighting import tone_map
 from radar_cli.results import MESH_GLB_FILE, MESH_OBJ_FILE
 from radar_cli.sor.mesh import triangulate
 
+# canonical frame (seen side at -z) -> export frame (seen side at +z): a proper rotation, so winding is kept
+TO_VIEWER_FRONT = np.array([-1.0, 1.0, -1.0])
 MAX_SPECULAR_FACTOR = 1.0  # MTL Ks lies in [0, 1]; rho (0..2) is halved and clipped for it
 
 
@@ -32,8 +35,8 @@ def build_mesh(state: ObjectState, n_cols: int) -> trimesh.Trimesh:
         name="albedo", baseColorTexture=texture, metallicFactor=0.0,
         roughnessFactor=roughness_from_shininess(float(state.alpha[0])), doubleSided=True)
     visual = trimesh.visual.TextureVisuals(uv=sor.uv.numpy(), material=material)
-    return trimesh.Trimesh(sor.vertices.numpy().astype(np.float64), sor.faces.numpy(), visual=visual,
-                           process=False)
+    vertices = sor.vertices.numpy().astype(np.float64) * TO_VIEWER_FRONT
+    return trimesh.Trimesh(vertices, sor.faces.numpy(), visual=visual, process=False)
 
 
 def write_meshes(folder: Path, state: ObjectState, n_cols: int) -> None:
