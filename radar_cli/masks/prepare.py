@@ -144,7 +144,8 @@ def _run(jobs: list[tuple], workers: int) -> Iterator[dict]:
     if workers <= 1 or len(jobs) <= 1:
         yield from map(_work, jobs)
         return
-    with multiprocessing.get_context("fork").Pool(workers, initializer=_init_worker) as pool:
+    # spawn, not fork: a parent that already ran OpenCV or torch thread pools can leave forked children deadlocked
+    with multiprocessing.get_context("spawn").Pool(workers, initializer=_init_worker) as pool:
         yield from pool.imap_unordered(_work, jobs)
 
 

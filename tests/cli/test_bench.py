@@ -37,3 +37,15 @@ def test_bench_masks_and_derender_print_json():
     assert result.exit_code == 0, result.output
     report = json.loads(result.output)
     assert report["network_images_per_s"] > 0 and report["full_images_per_s"] > 0 and report["failed"] == 0
+
+
+def test_bench_masks_with_worker_processes_finishes():
+    # worker processes started after the parent used OpenCV and torch once deadlocked (forked thread pools)
+    import subprocess
+    import sys
+
+    code = ("import torch, sys; from radar_cli.cli import cli; "
+            "cli(['bench', 'masks', '--photos', '2', '--long-side', '400', '--size', '64', '--workers', '2'])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=180)
+    assert out.returncode == 0, out.stderr
+    assert json.loads(out.stdout)["photos"] == 2
