@@ -2,6 +2,7 @@
 config, the step and the optimizers' settings as JSON metadata, so inference needs only the checkpoint.
 
     RUN_DIR/checkpoints/step_0001000.safetensors   written atomically; the last K are kept
+    RUN_DIR/model.safetensors                      the model alone, exported when the run completes
 
 Exported weights (`export_weights`) are the same format with only the model's tensors. Loading never
 unpickles anything; a corrupt file or one that does not fit the configuration raises CheckpointError.
@@ -27,6 +28,7 @@ from radar_cli.model.radar import RadarModel
 FORMAT = "radar-checkpoint-1"
 CHECKPOINT_DIR = "checkpoints"
 _NAME_RE = re.compile(r"^step_(\d{7,})\.safetensors$")
+MODEL_FILE = "model.safetensors"  # RUN_DIR/model.safetensors: weights + config only, written when a run completes
 
 
 @dataclass

@@ -20,7 +20,8 @@ from radar_cli.model.discriminator import PatchDiscriminator
 from radar_cli.model.losses import sad_discriminator_loss
 from radar_cli.model.radar import RadarModel
 from radar_cli.train import distributed as D
-from radar_cli.train.checkpoint import TrainState, list_checkpoints, restore, save_checkpoint
+from radar_cli.train.checkpoint import (MODEL_FILE, TrainState, export_weights, list_checkpoints, restore,
+                                       save_checkpoint)
 from radar_cli.train.data import StepBatchSampler, VaseDataset, make_loader, target_batch, to_batch
 from radar_cli.train.logging import RunLogger
 from radar_cli.train.step import Batch, generator_losses
@@ -194,6 +195,8 @@ def _run(config: RunConfig, data_dir: Path, run_dir: Path, resume: bool, overfit
                 D.barrier(info)
     finally:
         logger.close()
+    if info.is_main and ckpt is not None and state.step == t.iterations:
+        export_weights(ckpt, run_dir / MODEL_FILE)  # what `radar derender --checkpoint` takes
     seconds = time.perf_counter() - t0
     n = max(1, len(history))
     return TrainSummary(run_dir, start, state.step, terms, history, ckpt, seconds, seconds / n, state)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import torch
 from click.testing import CliRunner
 
 from radar_cli.cli import cli
@@ -27,6 +28,10 @@ def test_train_command_runs_the_cpu_preset(vases64, tmp_path):
     model, config = load_model(ckpt)
     assert config.name == "syn_vases_cpu" and config.train.iterations == 2 and config.train.batch_size == 4
     assert (run / "images" / "step_0000002.png").is_file() and (run / "loss_curve.png").is_file()
+    exported, exported_config = load_model(run / "model.safetensors")  # the finished run's weights for derender
+    assert exported_config == config
+    for name, value in model.state_dict().items():
+        assert torch.equal(value, exported.state_dict()[name]), name
     resumed = CliRunner().invoke(cli, ["train", "--config", str(PRESET), "--data", str(vases64), "--out", str(run),
                                        "--overfit", "4", "--iterations", "3", "--resume"])
     assert resumed.exit_code == 0, resumed.output
