@@ -75,6 +75,19 @@ def _format_for(path: Path) -> str:
     return {".png": "PNG", ".jpg": "JPEG", ".jpeg": "JPEG", ".gif": "GIF", ".webp": "WEBP"}.get(ext, "PNG")
 
 
+@contextmanager
+def image_errors(path: Path) -> Iterator[None]:
+    """Turn any failure to open or decode the image at `path` into one InputError naming the file."""
+    try:
+        yield
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except Image.DecompressionBombError as e:
+        raise InputError(f"{path}: image too large ({e})") from None
+    except (OSError, ValueError, SyntaxError) as e:
+        raise InputError(f"{path}: not a readable image ({e})") from None
+
+
 def read_image(path: str | Path, mode: str = "RGB") -> np.ndarray:
     """Read an image file as uint8 (H x W x 3 for RGB, H x W for L), honouring EXIF orientation.
 
@@ -84,21 +97,14 @@ def read_image(path: str | Path, mode: str = "RGB") -> np.ndarray:
     from PIL import ImageOps
 
     path = Path(path)
-    try:
-        with Image.open(path) as im:
-            im = ImageOps.exif_transpose(im)
-            if im.mode in ("I;16", "I;16B", "I;16L", "I"):
-                arr = np.asarray(im, dtype=np.float64)
-                scale = 65535.0 if arr.max() > 255 else 255.0
-                im = Image.fromarray((arr / scale * 255.0).clip(0, 255).astype(np.uint8))
-            if mode == "RGB" and im.mode in ("RGBA", "LA", "PA") or (im.mode == "P" and "transparency" in im.info):
-                im = im.convert("RGBA")
-                background = Image.new("RGBA", im.size, (255, 255, 255, 255))
-                im = Image.alpha_composite(background, im)
-            return np.asarray(im.convert(mode)).copy()
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such file") from None
-    except Image.DecompressionBombError as e:
-        raise InputError(f"{path}: image too large ({e})") from None
-    except (OSError, ValueError, SyntaxError) as e:
-        raise InputError(f"{path}: not a readable image ({e})") from None
+    with image_errors(path), Image.open(path) as im:
+        im = ImageOps.exif_transpose(im)
+        if im.mode in ("I;16", "I;16B", "I;16L", "I"):
+            arr = np.asarray(im, dtype=np.float64)
+            scale = 65535.0 if arr.max() > 255 else 255.0
+            im = Image.fromarray((arr / scale * 255.0).clip(0, 255).astype(np.uint8))
+        if mode == "RGB" and im.mode in ("RGBA", "LA", "PA") or (im.mode == "P" and "transparency" in im.info):
+            im = im.convert("RGBA")
+            background = Image.new("RGBA", im.size, (255, 255, 255, 255))
+            im = Image.alpha_composite(background, im)
+        return np.asarray(im.convert(mode)).copy()

@@ -10,7 +10,7 @@ import numpy as np
 from PIL import Image, ImageOps
 
 from radar_cli.errors import InputError
-from radar_cli.fileio import read_image
+from radar_cli.fileio import image_errors, read_image
 from radar_cli.masks import crop as crops
 from radar_cli.masks.detect import Detection, detect
 from radar_cli.masks.quality import Thresholds, judge, score_mask
@@ -69,21 +69,14 @@ def load_photo(path: str | Path, min_long_side: int = 1024) -> tuple[np.ndarray,
         (image, scale = decoded pixels per pixel of the upright original).
     """
     path = Path(path)
-    try:
-        with Image.open(path) as im:
-            if im.format == "JPEG":
-                original = im.size
-                want = min_long_side / max(original)
-                if want < 0.5:
-                    im.draft("RGB", (max(1, int(original[0] * want)), max(1, int(original[1] * want))))
-                rgb = np.asarray(ImageOps.exif_transpose(im).convert("RGB")).copy()
-                return rgb, _decoded_scale(rgb, original)
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such file") from None
-    except Image.DecompressionBombError as e:
-        raise InputError(f"{path}: image too large ({e})") from None
-    except (OSError, ValueError, SyntaxError) as e:
-        raise InputError(f"{path}: not a readable image ({e})") from None
+    with image_errors(path), Image.open(path) as im:
+        if im.format == "JPEG":
+            original = im.size
+            want = min_long_side / max(original)
+            if want < 0.5:
+                im.draft("RGB", (max(1, int(original[0] * want)), max(1, int(original[1] * want))))
+            rgb = np.asarray(ImageOps.exif_transpose(im).convert("RGB")).copy()
+            return rgb, _decoded_scale(rgb, original)
     return read_image(path, "RGB"), 1.0
 
 
