@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from radar_cli.errors import InputError
-from radar_cli.fileio import read_image, write_image
+from radar_cli.fileio import PNG_LEVEL, read_image, write_image
 
 IMAGE_FILE = "image.png"
 MASK_FILE = "mask.png"
@@ -87,7 +87,7 @@ def read_sample(ref: SampleRef) -> tuple[np.ndarray, np.ndarray]:
     return image, mask
 
 
-def write_sample(ref: SampleRef, image: np.ndarray, mask: np.ndarray) -> None:
+def write_sample(ref: SampleRef, image: np.ndarray, mask: np.ndarray, png_level: int = PNG_LEVEL) -> None:
     """Write a sample's image (H x W x 3, float [0,1] or uint8) and mask (H x W bool); atomic per file."""
-    write_image(ref.image_path, image)
-    write_image(ref.mask_path, (mask > 0.5).astype(np.uint8) * 255)
+    write_image(ref.image_path, image, png_level)
+    write_image(ref.mask_path, (mask > 0.5).astype(np.uint8) * 255, png_level)

@@ -62,12 +62,19 @@ def to_uint8(image: np.ndarray) -> np.ndarray:
     return (np.clip(image, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
 
 
-def write_image(path: str | Path, image: np.ndarray) -> None:
-    """Write an image atomically; float arrays are taken as [0, 1], uint8 as is. H x W or H x W x {3,4}."""
+PNG_LEVEL = 6  # zlib level of PNG writes (Pillow's default)
+FAST_PNG_LEVEL = 1  # for bulk writers (radar synth): 2.5x faster to encode, files ~25% larger
+
+
+def write_image(path: str | Path, image: np.ndarray, png_level: int = PNG_LEVEL) -> None:
+    """Write an image atomically; float arrays are taken as [0, 1], uint8 as is. H x W or H x W x {3,4}.
+    png_level: zlib compression level 0-9 when the file is a PNG."""
     if image.dtype != np.uint8:
         image = to_uint8(image)
+    fmt = _format_for(Path(path))
+    options = {"compress_level": png_level} if fmt == "PNG" else {}
     with atomic_path(path) as tmp:
-        Image.fromarray(image).save(tmp, format=_format_for(Path(path)))
+        Image.fromarray(image).save(tmp, format=fmt, **options)
 
 
 def _format_for(path: Path) -> str:

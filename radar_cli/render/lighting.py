@@ -56,9 +56,17 @@ def shading_factors(
     return diffuse.view(n_batch, h, w), specular.view(n_batch, h, w)
 
 
-CHUNK_ELEMENTS = 1 << 22  # B x samples x lights per chunk: bounds the B x N x E intermediates (16 MiB in float32)
+CHUNK_ELEMENTS = 1 << 18  # B x samples x lights per chunk: bounds the B x N x E intermediates (1 MiB in float32,
+# cache-sized: measured 2x faster than 16 MiB chunks on the CPU)
 KEEP_ELEMENTS = 1 << 25  # up to this B x N x E the forward's chunks are kept for backward (4 x 128 MiB in float32)
 # instead of recomputed; larger problems (64 x 64 grids at batch 24) recompute to keep memory flat
+BIG = 1e30  # step(x) = clamp(x * BIG, 0, 1): a 0/1 mask in two cheap passes (a comparison + masked_fill is ~15x
+# slower on the CPU); it differs from x > 0 only for 0 < x < 1e-30
+
+
+def _step(x: torch.Tensor) -> torch.Tensor:
+    """1 where x > 0 (x >= 1e-30), 0 where x <= 0, as x's dtype."""
+    return (x * BIG).clamp_(0.0, 1.0)
 
 
 def _phong_chunk(n: torch.Tensor, p: torch.Tensor, dirs: torch.Tensor, alpha: torch.Tensor):
@@ -66,15 +74,30 @@ def _phong_chunk(n: torch.Tensor, p: torch.Tensor, dirs: torch.Tensor, alpha: to
     light is below the surface or the lobe points away), log of it, and the lobe max(0, R.P)^alpha.
     R_i . P = L_i . R_v with R_v = 2 (N.P) N - P, the view direction mirrored about N."""
     ln = n @ dirs.T
-    mirror = 2 * (n * p).sum(-1, keepdim=True) * n - p  # B x n x 3
-    rp = (mirror @ dirs.T).clamp_min_(0.0).masked_fill_(ln <= 0, 0.0)
+    rp = _mirror_cos(n, p, dirs).mul_(_step(ln))
     log_rp = torch.log(rp.clamp_min(TINY))
     # exp(alpha log x) is much faster than a broadcast pow; the floor keeps exp away from denormals (slow on CPU)
-    lobe = torch.exp((log_rp * alpha[:, None, None]).clamp_min_(-60.0))
+    lobe = torch.exp((log_rp * alpha[:, None, None]).clamp_min_(LOG_FLOOR))
     return ln.clamp_min_(0.0), rp, log_rp, lobe
 
 
+def _mirror_cos(n: torch.Tensor, p: torch.Tensor, dirs: torch.Tensor) -> torch.Tensor:
+    """max(0, R_v . L) for every sample and light: B x n x E."""
+    mirror = 2 * (n * p).sum(-1, keepdim=True) * n - p  # B x n x 3
+    return (mirror @ dirs.T).clamp_min_(0.0)
+
+
+def _phong_sums(n: torch.Tensor, p: torch.Tensor, dirs: torch.Tensor, alpha: torch.Tensor, rad: torch.Tensor):
+    """Forward only, in place: (sum_L max(0, L.N) rad, sum_L lobe rad) for one chunk, each B x n."""
+    ln = n @ dirs.T
+    lobe = _mirror_cos(n, p, dirs).mul_(_step(ln))
+    lobe = lobe.clamp_min_(TINY).log_().mul_(alpha[:, None, None]).clamp_min_(LOG_FLOOR).exp_()
+    return (ln.clamp_min_(0.0) @ rad)[..., 0], (lobe @ rad)[..., 0]
+
+
 TINY = 1e-30  # floor inside log(R.P): the lobe of a dark light is exp(-69 alpha) ~ 0, never NaN
+LOG_FLOOR = -60.0  # floor of alpha log(R.P): lobes below exp(-60) are taken as exp(-60) (~1e-26, invisible)
+LOBE_FLOOR = 1e-26  # lobes at or below this (the floor) get no gradient
 
 
 class _Phong(torch.autograd.Function):
@@ -87,13 +110,18 @@ class _Phong(torch.autograd.Function):
         rad = radiance[..., None]  # B x E x 1
         keep = n.shape[0] * n.shape[1] * dirs.shape[0] <= KEEP_ELEMENTS
         diffuse, lobe_sum, ctx.chunks = [], [], []
+        keep = keep and any(ctx.needs_input_grad)
         for i in range(0, n.shape[1], step):
+            if not keep:
+                d, s = _phong_sums(n[:, i : i + step], p[:, i : i + step], dirs, alpha, rad)
+                diffuse.append(d)
+                lobe_sum.append(s)
+                continue
             chunk = _phong_chunk(n[:, i : i + step], p[:, i : i + step], dirs, alpha)
             ln, lobe = chunk[0], chunk[3]
             diffuse.append((ln @ rad)[..., 0])
             lobe_sum.append((lobe @ rad)[..., 0])
-            if keep and any(ctx.needs_input_grad):
-                ctx.chunks.append(chunk)
+            ctx.chunks.append(chunk)
         norm = (alpha[:, None] + 1) / (2 * math.pi)
         lobe_sum = torch.cat(lobe_sum, 1)  # B x N, kept: d I_s / d alpha needs it
         ctx.save_for_backward(n, p, radiance, alpha, dirs, lobe_sum)
@@ -118,9 +146,9 @@ class _Phong(torch.autograd.Function):
             # ... and from the lobe: norm * sum lobe log(rp) rad
             g_alpha += (gs * ((lobe * log_rp) @ rad)).sum((1, 2))
             # d lobe / d rp = alpha rp^(alpha - 1) where the light counts; d diffuse / d ln = rad where lit
-            g_rp = (lobe / rp.clamp_min(TINY)).masked_fill_(lobe <= 1e-26, 0.0) * radiance[:, None, :]
+            g_rp = (lobe / rp.clamp_min(TINY)).mul_(_step(lobe - LOBE_FLOOR)).mul_(radiance[:, None, :])
             g_rp *= gs * alpha[:, None, None]
-            g_ln = (gd * radiance[:, None, :]).masked_fill_(ln <= 0, 0.0)
+            g_ln = (gd * radiance[:, None, :]).mul_(_step(ln))
             g_mirror = g_rp @ dirs  # B x n x 3
             nk, pk = n[:, sl], p[:, sl]
             np_ = (nk * pk).sum(-1, keepdim=True)
@@ -138,7 +166,12 @@ def _chunk(n: torch.Tensor, dirs: torch.Tensor) -> int:
 
 def tone_map(x: torch.Tensor, gamma: float = GAMMA) -> torch.Tensor:
     """tau(x) = x^(1/gamma), with a floor so the gradient stays finite at 0."""
-    return x.clamp_min(EPS) ** (1.0 / gamma)
+    return power(x.clamp_min(EPS), 1.0 / gamma)
+
+
+def power(x: torch.Tensor, exponent: float) -> torch.Tensor:
+    """x^exponent for x > 0 as exp(exponent log x): 3x faster than torch.pow on the CPU, same gradient."""
+    return torch.exp(torch.log(x) * exponent)
 
 
 def compose(

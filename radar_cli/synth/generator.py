@@ -25,7 +25,7 @@ from tqdm import tqdm
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig, to_dict
 from radar_cli.dataset import IMAGE_FILE, MASK_FILE, SPLITS, SampleRef, sample_ref, write_sample
 from radar_cli.errors import ConfigError, InputError, RadarError
-from radar_cli.fileio import write_image, write_json, write_npy, write_text
+from radar_cli.fileio import FAST_PNG_LEVEL, write_image, write_json, write_npy, write_text
 from radar_cli.synth import layout
 from radar_cli.synth.lighting import bake_env, sample_lobes
 from radar_cli.synth.render import env_preview, render_sample
@@ -150,12 +150,12 @@ def write_sample_folder(root: Path, split: str, sid: str, files: dict, params: d
     tmp = root / PARTIAL_DIR / f"{split}-{sid}-{os.getpid()}"
     shutil.rmtree(tmp, ignore_errors=True)
     tmp.mkdir(parents=True)
-    write_sample(SampleRef(tmp.parent, "", tmp.name), files.pop(IMAGE_FILE), files.pop(MASK_FILE))
+    write_sample(SampleRef(tmp.parent, "", tmp.name), files.pop(IMAGE_FILE), files.pop(MASK_FILE), FAST_PNG_LEVEL)
     for name, arr in files.items():
         if name.endswith(".npy"):
             write_npy(tmp / name, arr)
         else:
-            write_image(tmp / name, arr.astype(np.uint8) * 255 if arr.dtype == bool else arr)
+            write_image(tmp / name, arr.astype(np.uint8) * 255 if arr.dtype == bool else arr, FAST_PNG_LEVEL)
     write_json(tmp / layout.PARAMS_FILE, params)
     if final.exists():  # an unfinished folder from an older run
         shutil.rmtree(final)

@@ -13,7 +13,7 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig, RenderConfig
-from radar_cli.render.lighting import tone_map
+from radar_cli.render.lighting import TINY, power, tone_map
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import shade
 from radar_cli.render.texture import render_texture
@@ -79,7 +79,7 @@ def render_sample(
     h = torch.tensor([height], dtype=torch.float32)
     v = torch.tensor([pose], dtype=torch.float32)  # 1 x 4
     display = torch.from_numpy(np.ascontiguousarray(albedo_display, dtype=np.float32)).permute(2, 0, 1)[None]
-    linear = display.clamp_min(0) ** render.gamma  # 1 x 3 x Ht x 3Wt
+    linear = power(display.clamp_min(TINY), render.gamma)  # 1 x 3 x Ht x 3Wt
     e = torch.from_numpy(np.asarray(env, dtype=np.float32))[None]  # 1 x He x We
     a, p = torch.tensor([alpha], dtype=torch.float32), torch.tensor([rho], dtype=torch.float32)
 

@@ -7,7 +7,8 @@ import math
 import torch
 
 from radar_cli.config import RenderConfig
-from radar_cli.render.lighting import compose, env_directions, shading_factors, tone_map
+from radar_cli.render import lighting
+from radar_cli.render.lighting import compose, env_directions, power, shading_factors, tone_map
 from radar_cli.render.scene import shade
 
 HE, WE = 16, 48
@@ -65,3 +66,36 @@ def test_compose_is_tone_mapped_sum():
     out = compose(albedo, diffuse, specular, rho)
     ref = (albedo * diffuse[:, None] + rho[:, None, None, None] * specular[:, None]) ** (1 / 2.2)
     assert torch.allclose(out, ref, atol=1e-5)
+
+
+def test_fast_forward_and_autograd_paths_match_the_direct_sum(monkeypatch):
+    """The in-place forward used without gradients, the kept-chunk forward used in training and a direct float64
+    sum of Eq. 6-7 agree, across several chunks."""
+    monkeypatch.setattr(lighting, "CHUNK_ELEMENTS", 2 * 50 * 192)  # 50 samples a chunk: 8 chunks
+    torch.manual_seed(3)
+    n = torch.nn.functional.normalize(torch.randn(2, 9, 40, 3), dim=-1)
+    view = torch.nn.functional.normalize(torch.randn(2, 9, 40, 3) + torch.tensor([0.0, 0.0, 2.0]), dim=-1)
+    env, alpha = torch.rand(2, 8, 24), torch.tensor([3.0, 150.0])
+    dirs, solid = env_directions(8, 24, dtype=torch.float64)
+    nd, vd = n.double().reshape(2, -1, 3), view.double().reshape(2, -1, 3)
+    ln = nd @ dirs.T
+    mirror = 2 * (nd * vd).sum(-1, keepdim=True) * nd - vd
+    rp = (mirror @ dirs.T).clamp_min(0) * (ln > 0)
+    rad = env.double().reshape(2, -1) * solid
+    want_d = (ln.clamp_min(0) * rad[:, None]).sum(-1).view(2, 9, 40)
+    a = alpha.double()[:, None, None]
+    want_s = ((a + 1) / (2 * math.pi) * rp ** a * rad[:, None]).sum(-1).view(2, 9, 40)
+    with torch.no_grad():
+        fast = shading_factors(n, view, env, alpha)
+    kept = shading_factors(n.requires_grad_(), view, env, alpha)
+    for got in (fast, kept):
+        torch.testing.assert_close(got[0].double(), want_d, rtol=1e-4, atol=1e-5)
+        torch.testing.assert_close(got[1].double(), want_s, rtol=1e-4, atol=1e-5)
+
+
+def test_power_matches_pow_with_its_gradient():
+    x = torch.rand(50, dtype=torch.float64).add_(1e-3).requires_grad_()
+    y = power(x, 1 / 2.2)
+    torch.testing.assert_close(y, x.detach() ** (1 / 2.2))
+    (g,) = torch.autograd.grad(y.sum(), x)
+    torch.testing.assert_close(g, (1 / 2.2) * x.detach() ** (1 / 2.2 - 1))
