@@ -65,6 +65,10 @@ class LossConfig:
     """lambda_s: MSE between soft and target silhouettes."""
     dt_weight: float = 100.0
     """lambda_dt: L1 of the predicted silhouette weighted by the target's distance transform (in image sides)."""
+    dt_margin_px: float = 0.0
+    """Pixels next to the target that the distance term leaves free (0 = the paper). The soft silhouette's own
+    halo lies there; penalising it biases the fit towards smaller silhouettes, and at 64 px that bias swamps the
+    pitch cue of the rim (see README, Accuracy)."""
     im_weight: float = 1.0
     alb_weight: float = 1.0
     sad_weight: float = 0.01

@@ -33,14 +33,17 @@ def distance_transform(mask: np.ndarray) -> np.ndarray:
 
 
 def silhouette_loss(sil: torch.Tensor, target: torch.Tensor, dt: torch.Tensor, w_mse: float,
-                    w_dt: float) -> torch.Tensor:
-    """L_sil = w_mse * MSE(S, S^) + w_dt * mean(dt(S) * S^) (Eq. 3).
+                    w_dt: float, margin_px: float = 0.0) -> torch.Tensor:
+    """L_sil = w_mse * MSE(S, S^) + w_dt * mean(max(0, dt(S) - margin) * S^) (Eq. 3; margin 0 in the paper).
 
     Args:
         sil: B x H x W predicted soft silhouette in [0, 1].
         target: B x H x W target silhouette (0/1 float).
         dt: B x H x W distance transform of the target (image sides).
+        margin_px: distance from the target, in pixels, within which the predicted silhouette is not penalised.
     """
+    if margin_px > 0:
+        dt = (dt - margin_px / dt.shape[-1]).clamp_min(0.0)
     return w_mse * ((sil - target) ** 2).mean() + w_dt * (dt * sil).mean()
 
 

@@ -97,7 +97,8 @@ def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig,
         terms["total"] = sum(terms.values())
         return terms, Rendered(hits, shading, recon, front, None, None)
     weight = batch.mask[:, None] * front  # S~ = S and S^_f, B x 1 x H x W
-    terms = {"sil": L.silhouette_loss(hits.sil, batch.mask, batch.dt, lc.sil_weight, lc.dt_weight),
+    terms = {"sil": L.silhouette_loss(hits.sil, batch.mask, batch.dt, lc.sil_weight, lc.dt_weight,
+                                         lc.dt_margin_px),
              "im": L.masked_l1(recon, batch.image, weight)}
     total = terms["sil"] + lc.im_weight * terms["im"]
     if not lc.no_alb:

@@ -20,8 +20,8 @@ from radar_cli.model.discriminator import PatchDiscriminator
 from radar_cli.model.losses import sad_discriminator_loss
 from radar_cli.model.radar import RadarModel
 from radar_cli.train import distributed as D
-from radar_cli.train.checkpoint import (MODEL_FILE, TrainState, export_weights, list_checkpoints, restore,
-                                       save_checkpoint)
+from radar_cli.train.checkpoint import (MODEL_FILE, TrainState, export_weights, initialise, list_checkpoints,
+                                       restore, save_checkpoint)
 from radar_cli.train.data import StepBatchSampler, VaseDataset, make_loader, target_batch, to_batch
 from radar_cli.train.logging import RunLogger
 from radar_cli.train.step import Batch, generator_losses
@@ -128,7 +128,7 @@ def apply_overrides(config: RunConfig, iterations: int | None, overfit: int | No
 
 def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: bool = False,
           device: str | None = None, overfit: int | None = None, iterations: int | None = None,
-          progress: bool = True) -> TrainSummary:
+          progress: bool = True, init: str | Path | None = None) -> TrainSummary:
     """Train RADAR on DATA/train and write checkpoints, metrics and images to run_dir.
 
     Args:
@@ -140,6 +140,8 @@ def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: 
         overfit: train on the first N samples only (a wiring test).
         iterations: total steps (overrides config.train.iterations).
         progress: show the progress bar.
+        init: start from this checkpoint's weights (fine-tuning); ignored when resuming a run that has
+            checkpoints of its own.
 
     Returns:
         TrainSummary.
@@ -155,19 +157,22 @@ def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: 
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
     try:
-        return _run(config, Path(data_dir), run_dir, resume, overfit, info, progress)
+        return _run(config, Path(data_dir), run_dir, resume, overfit, info, progress, init)
     finally:
         D.teardown(info)
 
 
 def _run(config: RunConfig, data_dir: Path, run_dir: Path, resume: bool, overfit: int | None,
-         info: D.DistInfo, progress: bool) -> TrainSummary:
+         info: D.DistInfo, progress: bool, init: str | Path | None) -> TrainSummary:
     t = config.train
     dataset = VaseDataset(data_dir, "train", config.model.render.image_size, limit=overfit)
     if config.loss.supervised:
         dataset.load_targets()
     state = build_state(config, info.device)
-    start = _resume(run_dir, config, state) if resume else 0
+    resuming = resume and (init is None or bool(list_checkpoints(run_dir)))
+    start = _resume(run_dir, config, state) if resuming else 0
+    if init is not None and not resuming:
+        initialise(init, state)
     model, disc = D.wrap(state.model, info), D.wrap(state.disc, info)
     sampler = StepBatchSampler(len(dataset), t.batch_size, t.seed, start, t.iterations, info.rank, info.world)
     logger = RunLogger(run_dir, start, t.iterations, enabled=info.is_main, bar=progress)

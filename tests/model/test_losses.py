@@ -32,6 +32,9 @@ def test_reference_values():
     dt = torch.tensor([[[0.0, 0.5], [0.5, 1.0]]])
     # MSE = 0.25 / 4, dt term = 0.25 / 4
     assert L.silhouette_loss(sil, target, dt, 10.0, 100.0).item() == pytest.approx(10 * 0.0625 + 100 * 0.0625)
+    # a 0.5 px margin (0.25 of this 2 px image's side) leaves dt = 0.5 -> 0.25 under the halo pixel
+    assert L.silhouette_loss(sil, target, dt, 10.0, 100.0, margin_px=0.5).item() == pytest.approx(
+        10 * 0.0625 + 100 * 0.125 / 4)
     pred, tgt = torch.zeros(1, 3, 2, 2), torch.ones(1, 3, 2, 2)
     weight = torch.tensor([[[[1.0, 0.0], [0.0, 0.0]]]])
     assert L.masked_l1(pred, tgt, weight).item() == pytest.approx(1.0)

@@ -9,8 +9,8 @@ import torch
 from safetensors.torch import save_file
 
 from radar_cli.errors import CheckpointError
-from radar_cli.train.checkpoint import (export_weights, list_checkpoints, load_model, read_checkpoint, restore,
-                                        save_checkpoint)
+from radar_cli.train.checkpoint import (export_weights, initialise, list_checkpoints, load_model, read_checkpoint,
+                                        restore, save_checkpoint)
 from radar_cli.train.trainer import build_state
 
 from .conftest import tiny_config
@@ -87,3 +87,25 @@ def test_mismatched_checkpoint_is_a_clear_error(saved, tmp_path):
     save_file(tensors, str(broken), metadata=meta)
     with pytest.raises(CheckpointError, match="model weights do not fit"):
         load_model(broken)
+
+
+def test_init_starts_a_new_run_from_weights_with_other_loss_settings(saved, tmp_path):
+    config, state, run = saved
+    sharper = dataclasses.replace(
+        config, loss=dataclasses.replace(config.loss, dt_margin_px=1.0),
+        model=dataclasses.replace(config.model, render=dataclasses.replace(config.model.render, sil_sigma_px=0.25)),
+        train=dataclasses.replace(config.train, seed=7))
+    fresh = build_state(sharper, torch.device("cpu"))
+    initialise(list_checkpoints(run)[-1], fresh)
+    assert fresh.step == 0  # a new run: step and optimizers start afresh
+    assert not fresh.opt_model.state
+    for a, b in zip(fresh.model.state_dict().values(), state.model.state_dict().values()):
+        assert torch.equal(a, b)
+    for a, b in zip(fresh.disc.state_dict().values(), state.disc.state_dict().values()):
+        assert torch.equal(a, b)
+    # an exported model file (no discriminator) also initialises the networks
+    exported = export_weights(list_checkpoints(run)[-1], tmp_path / "model.safetensors")
+    initialise(exported, build_state(sharper, torch.device("cpu")))
+    wider = dataclasses.replace(config, model=dataclasses.replace(config.model, albedo_width=16))
+    with pytest.raises(CheckpointError, match="model weights do not fit"):
+        initialise(exported, build_state(wider, torch.device("cpu")))

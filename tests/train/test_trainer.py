@@ -53,6 +53,21 @@ def test_resume_continues_exactly(vases32, tmp_path):
     assert steps == list(range(6))
 
 
+def test_init_fine_tunes_from_another_run_and_resumes_its_own(vases32, tmp_path):
+    first = train(tiny_config(iterations=2, checkpoint_every=2), vases32, tmp_path / "a", progress=False)
+    tuned = train(tiny_config(iterations=2, checkpoint_every=1), vases32, tmp_path / "b", progress=False,
+                  init=first.checkpoint, iterations=1)
+    assert tuned.start == 0 and tuned.end == 1
+    # the first step of the fine-tune starts from run a's weights: its loss is a's loss on that batch, not a
+    # fresh network's
+    fresh = train(tiny_config(iterations=1), vases32, tmp_path / "c", progress=False)
+    assert tuned.history[0]["total"] != pytest.approx(fresh.history[0]["total"], rel=1e-6)
+    # killed and rerun with --resume --init: continues from its own checkpoint, not from --init again
+    resumed = train(tiny_config(iterations=2, checkpoint_every=1), vases32, tmp_path / "b", resume=True,
+                    progress=False, init=first.checkpoint)
+    assert resumed.start == 1 and resumed.end == 2
+
+
 def test_resume_without_checkpoint_is_an_error(vases32, tmp_path):
     with pytest.raises(RadarError, match="no checkpoint"):
         train(tiny_config(), vases32, tmp_path / "empty", resume=True, progress=False)
