@@ -94,4 +94,5 @@ bench: $(STAMP)
 	$(RADAR) bench render --device $(DEVICE)
 	$(RADAR) bench train --config pipelines/syn_vases_cpu.toml
 	$(RADAR) bench masks
+	$(RADAR) bench synth
 	$(RADAR) bench derender

@@ -1,4 +1,4 @@
-"""`radar bench`: speed and memory benchmarks, one subcommand per stage (render, train, masks, derender)."""
+"""`radar bench`: speed and memory benchmarks, one subcommand per stage (render, train, masks, synth, derender)."""
 
 from __future__ import annotations
 
@@ -58,6 +58,19 @@ def masks(photos: int, long_side: int, size: int, workers: int) -> None:
     from radar_cli.masks.benchmark import bench_masks
 
     click.echo(json.dumps(bench_masks(photos, long_side, size, workers), indent=2))
+
+
+@bench.command("synth")
+@click.option("--size", default=256, show_default=True, type=click.IntRange(16, 1024), help="Image side in pixels.")
+@click.option("--n", "n", default=120, show_default=True, type=click.IntRange(min=1), help="Samples to generate.")
+@click.option("--workers", default=2, show_default=True, type=click.IntRange(min=1))
+@click.option("--shading-size", default=0, show_default=True, type=click.IntRange(min=0),
+              help="Lighting grid side for the frontal third (0 = radar synth's default).")
+def synth(size: int, n: int, workers: int, shading_size: int) -> None:
+    """Samples per second through `radar synth` (sample, render every map, write), and make vs write time."""
+    from radar_cli.synth.benchmark import bench_synth
+
+    click.echo(json.dumps(bench_synth(size, n, workers, shading_size), indent=2))
 
 
 @bench.command("derender")

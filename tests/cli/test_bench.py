@@ -49,3 +49,11 @@ def test_bench_masks_with_worker_processes_finishes():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=180)
     assert out.returncode == 0, out.stderr
     assert json.loads(out.stdout)["photos"] == 2
+
+
+def test_bench_synth_prints_throughput_and_stage_split():
+    result = CliRunner().invoke(cli, ["bench", "synth", "--size", "32", "--n", "3", "--workers", "1"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.output)
+    assert out["samples"] == 3 and out["failed"] == 0 and out["samples_per_sec"] > 0
+    assert out["sec_per_sample_make"] > 0 and out["sec_per_sample_write"] > 0
