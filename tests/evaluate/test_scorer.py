@@ -11,7 +11,7 @@ from click.testing import CliRunner
 
 from radar_cli.cli import cli
 from radar_cli.evaluate.from_truth import Perturbation, results_from_synth
-from radar_cli.evaluate.scorer import PAPER_TABLE2, evaluate, markdown_table, report_json
+from radar_cli.evaluate.scorer import PAPER_TABLE2, evaluate, markdown_table, pitch_calibration, report_json
 from radar_cli.results import ResultPaths
 from radar_cli.synth.generator import SynthConfig, generate
 
@@ -100,3 +100,22 @@ def test_cli_eval_exit_codes_and_json(synth_set, tmp_path):
     assert bad.exit_code == 1 and "skipped 000002" in bad.output and "normal_rendered.png" in bad.output
     gone = CliRunner().invoke(cli, ["eval", "--pred", str(tmp_path / "nope"), "--gt", str(synth_set)])
     assert gone.exit_code == 2 and "no such results folder" in gone.output
+
+
+def test_pitch_calibration_slope_and_correlation():
+    true = [0.0, 5.0, 10.0, 15.0, 20.0]
+    calibrated = pitch_calibration([t + 1.5 for t in true], true)  # an offset keeps slope and correlation at 1
+    assert calibrated["slope"] == pytest.approx(1.0) and calibrated["correlation"] == pytest.approx(1.0)
+    collapsed = pitch_calibration([10.0] * 5, true)  # always the mean pitch
+    assert collapsed == {"slope": 0.0, "correlation": 0.0}
+    # half as steep, hand computed: pred = 10 + (t - 10) / 2
+    assert pitch_calibration([5.0, 7.5, 10.0, 12.5, 15.0], true)["slope"] == pytest.approx(0.5)
+    assert np.isnan(pitch_calibration([1.0], [2.0])["slope"])
+
+
+def test_table_reports_pitch_calibration(synth_set, tmp_path):
+    perturb = Perturbation(pitch_offset=1.5)
+    results_from_synth(synth_set, tmp_path, perturb=perturb)
+    report = evaluate(tmp_path, synth_set, progress=False)
+    assert report.summary()["pitch_calibration"]["slope"] == pytest.approx(1.0, abs=1e-6)
+    assert "Pitch calibration (predicted vs true): slope 1.00, correlation 1.00" in markdown_table(report)
