@@ -35,7 +35,7 @@ def split_sizes(split: str, n: int | None) -> dict[str, int]:
               help="Grey level of the plain background.")
 @click.option("--tex-size", type=click.IntRange(min=0), default=0, help="Albedo map rows (0 = image size).")
 @click.option("--shading-size", type=click.IntRange(min=0), default=0,
-              help="Lighting grid side for the frontal third (0 = min(64, size/2)).")
+              help="Lighting grid side for the frontal third (0 = min(32, size/2): 32 x 96 over the full turn).")
 @click.option("--random-roll", is_flag=True, help="Roll uniform in the geometry's range (default 0).")
 @click.option("--random-translation", is_flag=True, help="tx, ty uniform in the geometry's range (default 0).")
 def synth(out: str, n: int | None, size: int, seed: int, split: str, textures: str | None, workers: int,

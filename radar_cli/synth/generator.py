@@ -33,6 +33,7 @@ from radar_cli.synth.shapes import sample_shape
 from radar_cli.synth.textures import augment, image_texture, list_texture_images, procedural_texture
 
 FORMAT_VERSION = 1
+DEFAULT_SHADING = 32  # rows (and frontal-third columns) of the lighting grid when shading_size = 0
 MAX_SIZE = 1024
 PARTIAL_DIR = ".partial"  # samples being written; removed at the start of every run
 
@@ -47,7 +48,9 @@ class SynthConfig:
     tex_size: int = 0
     """Rows (and frontal-third columns) of the albedo map; 0 = the image size (the 360 deg map is 3x wider)."""
     shading_size: int = 0
-    """Side of the frontal-third grid the lighting is evaluated on; 0 = min(64, size // 2)."""
+    """Side of the frontal-third grid the lighting is evaluated on; 0 = DEFAULT_SHADING (or size // 2 if smaller):
+    32 x 96 over the full turn, the paper's vertex grid. Finer grids change a 256 px image by 55 dB PSNR on average
+    (40 dB at worst, on 16 vases, measured against 64) and cost 4x more."""
     background: float = 1.0
     """Grey level of the plain background (1 = white, like museum photographs)."""
     random_roll: bool = False
@@ -57,7 +60,7 @@ class SynthConfig:
 
     def render_config(self) -> RenderConfig:
         tex = self.tex_size or self.size
-        shading = self.shading_size or max(8, min(64, self.size // 2))
+        shading = self.shading_size or max(8, min(DEFAULT_SHADING, self.size // 2))
         return RenderConfig(image_size=self.size, tex_height=tex, tex_width=tex, shading_height=shading,
                             shading_width=shading)
 
@@ -186,7 +189,10 @@ def _init_worker() -> None:
 def _check_settings(root: Path, cfg: SynthConfig) -> None:
     """Write DATA/synth.json, or check that an existing one matches (a resumed run must not mix settings)."""
     path = root / layout.SETTINGS_FILE
-    settings = {"format_version": FORMAT_VERSION, **to_dict(cfg)}
+    render = cfg.render_config()  # the effective grids, so a changed default cannot mix two kinds of sample
+    settings = {"format_version": FORMAT_VERSION, **to_dict(cfg),
+                "effective": {"tex": [render.tex_height, 3 * render.tex_width],
+                              "shading": [render.shading_height, 3 * render.shading_width]}}
     if path.is_file():
         try:
             old = json.loads(path.read_text(encoding="utf-8"))

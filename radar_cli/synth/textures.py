@@ -43,9 +43,10 @@ def _soft(signed_px: np.ndarray) -> np.ndarray:
 
 
 def _blend(tex: np.ndarray, mask: np.ndarray, colour: np.ndarray) -> np.ndarray:
-    """tex painted with colour where mask (H x W or broadcastable) is 1: tex + (colour - tex) * mask."""
+    """tex painted with colour where mask (H x W or broadcastable) is 1: tex + (colour - tex) * mask, in place."""
     m = np.broadcast_to(mask, tex.shape[:2])[..., None]
-    return tex + (colour[None, None, :] - tex) * m
+    tex += (colour[None, None, :] - tex) * m
+    return tex
 
 
 def periodic_noise(rng: np.random.Generator, canvas: _Canvas, cells: tuple[int, int], octaves: int = 1) -> np.ndarray:

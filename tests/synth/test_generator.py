@@ -77,6 +77,16 @@ def test_resume_refuses_other_settings(tmp_path):
         generate(tmp_path, {"train": 1}, SynthConfig(size=40, tex_size=16, shading_size=8), progress=False)
 
 
+def test_resume_refuses_a_set_whose_effective_grid_differs(tmp_path):
+    generate(tmp_path, {"train": 1}, TINY, progress=False)
+    path = tmp_path / layout.SETTINGS_FILE
+    old = json.loads(path.read_text())
+    del old["effective"]  # written by a version whose default grid may differ
+    path.write_text(json.dumps(old))
+    with pytest.raises(ConfigError, match="effective"):
+        generate(tmp_path, {"train": 1}, TINY, progress=False)
+
+
 def test_make_sample_is_a_pure_function_of_seed_split_index():
     f1, p1 = make_sample(TINY, "test", 4, None)
     f2, p2 = make_sample(TINY, "test", 4, None)
