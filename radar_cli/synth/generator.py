@@ -18,6 +18,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import cv2
 import numpy as np
 import torch
 from tqdm import tqdm
@@ -183,7 +184,9 @@ def _work(job: tuple[SynthConfig, str, str, int, list[Path] | None]) -> tuple[st
 
 
 def _init_worker() -> None:
+    """One thread per worker for torch and OpenCV: the pool is the parallelism (more threads oversubscribe)."""
     torch.set_num_threads(1)
+    cv2.setNumThreads(1)
 
 
 def _check_settings(root: Path, cfg: SynthConfig) -> None:
