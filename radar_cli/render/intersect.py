@@ -94,8 +94,7 @@ def _first(values: torch.Tensor, ray_idx: torch.Tensor, m: int) -> torch.Tensor:
 
 @torch.no_grad()
 def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_idx: torch.Tensor,
-           h: torch.Tensor, s_near: torch.Tensor, s_far: torch.Tensor, deep: float = float("inf"),
-           minimise: bool = True) -> Found:
+           h: torch.Tensor, s_near: torch.Tensor, s_far: torch.Tensor, deep: float = float("inf")) -> Found:
     """Exact first hits, mouth exits and minimisers of F = max(rho - r(y), |y| - h) along M rays.
 
     Args:
@@ -106,9 +105,6 @@ def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_
         s_near, s_far: M span of each ray inside the (inflated) bounding cylinder.
         deep: rays whose chord through the solid has F < -deep at its middle skip the exact minimisation of F
             (their soft silhouette is saturated): s_min is that middle point instead.
-        minimise: False skips the minimisation of F altogether (no soft silhouette wanted): s_min is then the
-            middle of the first chord for hits, and both s_min and s_hit are the closest approach to the
-            object's centre for misses.
 
     Returns:
         Found (all M).
@@ -135,10 +131,6 @@ def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_
 
     hits = _hits(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, flat, b_idx, h, n_rows, -s_c)
     mid = hits.s_min
-    if not minimise:
-        zero = torch.zeros_like(mid)
-        return Found(torch.where(hits.hit, mid, zero) + s_c, torch.where(hits.hit, hits.s_hit, zero) + s_c,
-                     hits.hit, hits.inner, hits.cap)
     inside = hits.hit & (_implicit(ray, mid[:, None], h, flat, b_idx, n_rows)[:, 0] < -deep)
     keep = ~inside.index_select(0, ray_idx)
     if not bool(keep.all()):

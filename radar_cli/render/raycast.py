@@ -36,8 +36,7 @@ class Hits:
         mask: B x H x W bool, the ray meets the surface.
         inner: B x H x W bool, the surface met is the inside of the vase (seen through the mouth).
         depth: B x H x W camera-space z of the hit, 0 where there is none; differentiable.
-        points: B x H x W x 3 camera-space hit points (where there is no hit: some point of the ray near the
-            object, 0 outside its bounding cylinder; not meaningful).
+        points: B x H x W x 3 camera-space hit points (closest approach where there is no hit).
         normal: B x H x W x 3 camera-space unit normal of the side that is seen (0 where no hit).
         uv: B x H x W x 2 texture coordinates (u = angle / pi in [-1, 1], 0 facing the camera; v in [-1, 1],
             -1 at the top) of the hit, or of the closest approach for rays that miss (for anti-aliasing).
@@ -95,7 +94,6 @@ def cast_rays(
     size: int,
     camera: CameraConfig = CameraConfig(),
     sigma_px: float = 1.0,
-    soft: bool = True,
 ) -> Hits:
     """Cast one ray per pixel at a batch of solids of revolution.
 
@@ -106,8 +104,6 @@ def cast_rays(
         size: image side in pixels.
         camera: the fixed camera.
         sigma_px: softness of the soft silhouette in pixels.
-        soft: False skips the soft silhouette (Hits.sil is then the hard mask, with no gradient) and the search
-            for each ray's closest approach it needs: a quarter less work where only hits are wanted (synthesis).
 
     Returns:
         Hits with H = W = size.
@@ -124,23 +120,19 @@ def cast_rays(
     d_obj = dirs @ rot  # B x P x 3: R^T applied to each ray direction
     r_world, h_world = radius * camera.r_max, height * camera.r_max
 
-    margin = CULL_SIGMAS * sigma if soft else 0.0
-    s_near, s_far = _span(origin.detach(), d_obj.detach(), r_world.detach().amax(1) + margin,
-                          h_world.detach() + margin)
+    s_near, s_far = _span(origin.detach(), d_obj.detach(), r_world.detach().amax(1) + CULL_SIGMAS * sigma,
+                          h_world.detach() + CULL_SIGMAS * sigma)
     active = s_far > s_near  # B x P
     b_idx, p_idx = active.nonzero(as_tuple=True)
     rays = _Rays(b_idx, origin[b_idx], d_obj[b_idx, p_idx], r_world, h_world[b_idx])
     flat = b_idx * d_obj.shape[1] + p_idx
 
     found = search(rays.o.detach(), rays.d.detach(), r_world.detach(), b_idx, rays.h.detach(),
-                   s_near[b_idx, p_idx], s_far[b_idx, p_idx], deep=DEEP_SIGMAS * sigma, minimise=soft)
-    if soft:
-        g = _margin(rays, found.s_min)  # differentiable margin, world units
-        # g is close to the distance from the ray to the solid, ~ pixels * pixel size at the object; the taper
-        # takes the soft silhouette to exactly 0 at the culling margin, so it stays continuous in every input
-        sil_m = torch.sigmoid(-g / sigma) * (CULL_SIGMAS - g / sigma).clamp(0.0, 1.0)
-    else:
-        sil_m = found.hit.to(dt)
+                   s_near[b_idx, p_idx], s_far[b_idx, p_idx], deep=DEEP_SIGMAS * sigma)
+    g = _margin(rays, found.s_min)  # differentiable margin, world units
+    # g is close to the distance from the ray to the solid, ~ pixels * pixel size at the object; the taper
+    # takes the soft silhouette to exactly 0 at the culling margin, so it stays continuous in every input
+    sil_m = torch.sigmoid(-g / sigma) * (CULL_SIGMAS - g / sigma).clamp(0.0, 1.0)
 
     s_hit, normals, uv = _surface_at(rays, found, row_slopes(radius, height))
     # the camera sits at the origin: a point at parameter s along pixel p's ray is s * dirs[p] in camera space

@@ -49,17 +49,3 @@ def test_silhouette_and_depth_match_trimesh(random_sor):
     assert np.mean(ious) >= 0.99, ious
     assert min(ious) >= 0.97, ious
     assert max(depth_errs) <= 0.005, depth_errs
-
-
-def test_hard_only_casting_gives_the_same_hits(random_sor):
-    """soft=False (synthesis) skips the soft silhouette but finds the same hits, depths, normals and uv."""
-    radius, height, pose = random_sor(6, seed=2)
-    soft = cast_rays(radius, height, pose, 64)
-    with torch.no_grad():
-        hard = cast_rays(radius, height, pose, 64, soft=False)
-    hit = soft.mask
-    assert torch.equal(hard.mask, hit) and torch.equal(hard.inner, soft.inner)
-    assert torch.equal(hard.sil, hit.to(hard.sil.dtype))
-    for name in ("depth", "normal", "uv", "points"):
-        torch.testing.assert_close(getattr(hard, name)[hit], getattr(soft, name)[hit].detach(), rtol=0, atol=1e-6)
-    assert torch.isfinite(hard.points).all() and (hard.normal[~hit] == 0).all()
