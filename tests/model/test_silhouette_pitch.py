@@ -23,7 +23,7 @@ def argmin_pitch_errors(sigma_px: float, margin_px: float, n: int = 12) -> np.nd
         radius = torch.tensor(np.asarray(shape.radius), dtype=torch.float32)[None]
         height = torch.tensor([shape.height], dtype=torch.float32)
         with torch.no_grad():
-            target = cast_rays(radius, height, torch.tensor([shape.pose], dtype=torch.float32), SIZE, soft=False).mask
+            target = cast_rays(radius, height, torch.tensor([shape.pose], dtype=torch.float32), SIZE).mask
             dt = torch.from_numpy(distance_transform(target[0].numpy()))[None]
             losses = []
             for pitch in PITCHES:
