@@ -77,6 +77,10 @@ class LossConfig:
     """xi: target mean of the diffuse factor."""
     diff_margin: float = 0.1
     """Delta: tolerated deviation from xi."""
+    mouth_weight: float = 0.0
+    """Weight of L_alb carried into the open mouth (losses.mouth_l1; 0 = off, the paper). Needs L_alb."""
+    mouth_sigma_px: float = 1.0
+    """Softness of the mouth's rim for that term, in pixels; it is scored within 4x this of the rim."""
     sad_patch: int = 64
     """Side of the albedo patches shown to the discriminator (a power of two >= 8)."""
     sad_patches_per_image: int = 4
@@ -124,6 +128,8 @@ class RunConfig:
         tex = self.model.render
         if p < 8 or p & (p - 1) or p > min(tex.tex_height, tex.tex_width):
             raise ConfigError(f"loss.sad_patch must be a power of two in [8, texture size], got {p}")
+        if self.loss.mouth_weight < 0 or self.loss.mouth_sigma_px <= 0:
+            raise ConfigError("loss.mouth_weight must be >= 0 and loss.mouth_sigma_px > 0")
         if not 0 < self.loss.sad_group_fraction <= 0.5:
             raise ConfigError(f"loss.sad_group_fraction must lie in (0, 0.5], got {self.loss.sad_group_fraction}")
         if self.train.batch_size < 1 or self.train.iterations < 0 or self.train.keep_checkpoints < 1:

@@ -57,6 +57,23 @@ def masked_l1(pred: torch.Tensor, target: torch.Tensor, weight: torch.Tensor) ->
     return ((pred - target).abs() * weight).sum() / total
 
 
+def mouth_l1(recon_mu: torch.Tensor, front: torch.Tensor, mouth: torch.Tensor, image: torch.Tensor,
+             region: torch.Tensor, inside_dim: float) -> torch.Tensor:
+    """L_alb carried into the open mouth (radar's addition, off in the paper's presets): where the soft mouth
+    coverage is on, the single-colour rendering shows the inside, its mean frontal colour dimmed by inside_dim.
+    Fitting that darker ellipse to the image moves the rim, and with it the pitch, smoothly.
+
+    Args:
+        recon_mu: B x 3 x H x W single-colour rendering of the frontal third (0 elsewhere).
+        front: B x 1 x H x W its frontal mask. mouth: B x 1 x H x W soft mouth coverage (differentiable).
+        image: B x 3 x H x W target. region: B x 1 x H x W pixels scored (no gradient).
+    """
+    area = front.sum(dim=(2, 3), keepdim=True).clamp_min(1.0)
+    inside = inside_dim * (recon_mu * front).sum(dim=(2, 3), keepdim=True) / area  # B x 3 x 1 x 1
+    pred = recon_mu * (1 - mouth) + inside * mouth
+    return masked_l1(pred, image, region)
+
+
 def mean_color(albedo: torch.Tensor) -> torch.Tensor:
     """A^_mu: the albedo replaced by its mean colour (B x 3 x Ht x Wt -> same shape)."""
     return albedo.mean(dim=(2, 3), keepdim=True).expand_as(albedo)

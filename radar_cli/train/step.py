@@ -14,6 +14,7 @@ from radar_cli.model import losses as L
 from radar_cli.model.config import RunConfig
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.lighting import compose, tone_map
+from radar_cli.render.mouth import mouth_coverage
 from radar_cli.render.raycast import Hits, cast_rays
 from radar_cli.render.scene import Shading, render_front, shade
 
@@ -72,6 +73,23 @@ def render_prediction(pred: Decomposition, config: RunConfig) -> tuple[Hits, Sha
     return hits, shading, recon, front
 
 
+def _mouth_term(pred: Decomposition, hits: Hits, recon_mu: torch.Tensor, front: torch.Tensor, batch: Batch,
+                config: RunConfig) -> torch.Tensor:
+    """losses.mouth_l1 scored on the true silhouette's frontal and inside pixels within 4 sigma of where the mouth
+    is or would be at the largest pitch (so a flatter pose cannot hide the mouth from the term)."""
+    m, lc = config.model, config.loss
+    size = m.render.image_size
+    mouth = mouth_coverage(pred.radius, pred.height, pred.pose, size, m.camera, lc.mouth_sigma_px)[:, None]
+    with torch.no_grad():
+        steepest = pred.pose.detach().clone()
+        steepest[:, 0] = m.geometry.pitch_range[1]
+        band = torch.maximum(*(mouth_coverage(pred.radius, pred.height, pose, size, m.camera, 4 * lc.mouth_sigma_px)
+                               for pose in (pred.pose, steepest))) > 0.01
+        seen = torch.maximum(front, hits.inner[:, None].to(front.dtype))
+        region = batch.mask[:, None] * band[:, None].to(front.dtype) * seen
+    return L.mouth_l1(recon_mu, front, mouth, batch.image, region, m.render.inside_dim)
+
+
 def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig,
                      disc: nn.Module | None) -> tuple[dict[str, torch.Tensor], Rendered]:
     """Every loss term of the model (not of D) and their weighted sum under the key "total".
@@ -106,6 +124,9 @@ def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig,
         recon_mu, _ = render_front(hits, tex_mu)
         terms["alb"] = L.masked_l1(recon_mu, batch.image, weight)
         total = total + lc.alb_weight * terms["alb"]
+        if lc.mouth_weight > 0:
+            terms["mouth"] = _mouth_term(pred, hits, recon_mu, front, batch, config)
+            total = total + lc.mouth_weight * terms["mouth"]
     if not lc.no_diff:
         terms["diff"] = L.diffuse_loss(shading.diffuse, lc.diff_target, lc.diff_margin)
         total = total + lc.diff_weight * terms["diff"]
