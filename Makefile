@@ -61,11 +61,18 @@ table2: $(STAMP)
 syn-data-cpu: $(STAMP)
 	$(RADAR) synth --out data/syn_cpu --size 64 --workers $(WORKERS)
 
+# The bundled model's three stages: the paper's losses, then a sharp silhouette, then the mouth term.
 train-syn-cpu: $(STAMP)
 	$(RADAR) train --config pipelines/syn_vases_cpu.toml --data data/syn_cpu --out runs/syn_cpu --device cpu
+	$(RADAR) train --config pipelines/syn_vases_cpu_sharp.toml --init runs/syn_cpu/checkpoints/step_0006500.safetensors \
+		--data data/syn_cpu --out runs/syn_cpu_sharp --device cpu
+	$(RADAR) train --config pipelines/syn_vases_cpu_mouth.toml \
+		--init runs/syn_cpu_sharp/checkpoints/step_0004500.safetensors --data data/syn_cpu --out runs/syn_cpu_mouth \
+		--device cpu
 
 eval-syn-cpu: $(STAMP)
-	$(RADAR) derender data/syn_cpu/test --checkpoint runs/syn_cpu/model.safetensors --out results/syn_cpu --views 0
+	$(RADAR) derender data/syn_cpu/test --checkpoint runs/syn_cpu_mouth/model.safetensors --out results/syn_cpu \
+		--views 0
 	$(RADAR) eval --pred results/syn_cpu --gt data/syn_cpu --json results/syn_cpu/eval.json
 
 table2-cpu: $(STAMP)
