@@ -60,8 +60,8 @@ class SampleScore:
     env: float
     albedo_no_decomposition: float
     region_px: int
-    pitch_pred: float = math.nan
-    pitch_true: float = math.nan
+    pitch_pred: float
+    pitch_true: float
 
 
 @dataclass

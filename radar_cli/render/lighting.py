@@ -73,24 +73,24 @@ def _phong_chunk(n: torch.Tensor, p: torch.Tensor, dirs: torch.Tensor, alpha: to
     """Per-light terms for one chunk of samples (B x n x 3 each), all B x n x E: clamped L.N, R.P (0 where the
     light is below the surface or the lobe points away), log of it, and the lobe max(0, R.P)^alpha.
     R_i . P = L_i . R_v with R_v = 2 (N.P) N - P, the view direction mirrored about N."""
-    ln = n @ dirs.T
-    rp = _mirror_cos(n, p, dirs).mul_(_step(ln))
+    ln, rp = _cosines(n, p, dirs)
     log_rp = torch.log(rp.clamp_min(TINY))
     # exp(alpha log x) is much faster than a broadcast pow; the floor keeps exp away from denormals (slow on CPU)
     lobe = torch.exp((log_rp * alpha[:, None, None]).clamp_min_(LOG_FLOOR))
     return ln.clamp_min_(0.0), rp, log_rp, lobe
 
 
-def _mirror_cos(n: torch.Tensor, p: torch.Tensor, dirs: torch.Tensor) -> torch.Tensor:
-    """max(0, R_v . L) for every sample and light: B x n x E."""
+def _cosines(n: torch.Tensor, p: torch.Tensor, dirs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """For every sample and light, B x n x E each: L.N (unclamped) and max(0, R_v . L), 0 where the light is
+    below the surface."""
+    ln = n @ dirs.T
     mirror = 2 * (n * p).sum(-1, keepdim=True) * n - p  # B x n x 3
-    return (mirror @ dirs.T).clamp_min_(0.0)
+    return ln, (mirror @ dirs.T).clamp_min_(0.0).mul_(_step(ln))
 
 
 def _phong_sums(n: torch.Tensor, p: torch.Tensor, dirs: torch.Tensor, alpha: torch.Tensor, rad: torch.Tensor):
     """Forward only, in place: (sum_L max(0, L.N) rad, sum_L lobe rad) for one chunk, each B x n."""
-    ln = n @ dirs.T
-    lobe = _mirror_cos(n, p, dirs).mul_(_step(ln))
+    ln, lobe = _cosines(n, p, dirs)
     lobe = lobe.clamp_min_(TINY).log_().mul_(alpha[:, None, None]).clamp_min_(LOG_FLOOR).exp_()
     return (ln.clamp_min_(0.0) @ rad)[..., 0], (lobe @ rad)[..., 0]
 
@@ -108,9 +108,8 @@ class _Phong(torch.autograd.Function):
     def forward(ctx, n, p, radiance, alpha, dirs):
         step = _chunk(n, dirs)
         rad = radiance[..., None]  # B x E x 1
-        keep = n.shape[0] * n.shape[1] * dirs.shape[0] <= KEEP_ELEMENTS
+        keep = any(ctx.needs_input_grad) and n.shape[0] * n.shape[1] * dirs.shape[0] <= KEEP_ELEMENTS
         diffuse, lobe_sum, ctx.chunks = [], [], []
-        keep = keep and any(ctx.needs_input_grad)
         for i in range(0, n.shape[1], step):
             if not keep:
                 d, s = _phong_sums(n[:, i : i + step], p[:, i : i + step], dirs, alpha, rad)

@@ -87,6 +87,21 @@ class _Rays:
         return torch.maximum(lateral, cap)
 
 
+def object_rays(pose: torch.Tensor, size: int, camera: CameraConfig = CameraConfig()):
+    """The camera's pixel rays in each object's canonical frame.
+
+    Returns:
+        (rot B x 3 x 3 object-to-camera rotation, origin B x 3 camera centre in the object frame,
+         dirs P x 3 unit pixel directions in the camera frame, d_obj B x P x 3 the same in the object frame),
+        P = size * size; differentiable in pose.
+    """
+    rot = rotation_matrix(pose)  # B x 3 x 3
+    origin = -(rot.transpose(1, 2) @ translation(pose, camera)[..., None])[..., 0]  # B x 3
+    dirs = pixel_rays(size, camera, pose.device, pose.dtype).reshape(-1, 3)
+    dirs = dirs / dirs.norm(dim=-1, keepdim=True)
+    return rot, origin, dirs, dirs @ rot  # R^T applied to each ray direction
+
+
 def cast_rays(
     radius: torch.Tensor,
     height: torch.Tensor,
@@ -113,11 +128,7 @@ def cast_rays(
         raise InputError(f"size must be >= 1 and sigma_px > 0, got size={size}, sigma_px={sigma_px}")
     n_batch, dev, dt = radius.shape[0], radius.device, radius.dtype
     sigma = sigma_px * pixel_size(size, camera)
-    rot = rotation_matrix(pose)  # B x 3 x 3
-    origin = -(rot.transpose(1, 2) @ translation(pose, camera)[..., None])[..., 0]  # B x 3
-    dirs = pixel_rays(size, camera, dev, dt).reshape(-1, 3)
-    dirs = dirs / dirs.norm(dim=-1, keepdim=True)
-    d_obj = dirs @ rot  # B x P x 3: R^T applied to each ray direction
+    rot, origin, dirs, d_obj = object_rays(pose, size, camera)
     r_world, h_world = radius * camera.r_max, height * camera.r_max
 
     s_near, s_far = _span(origin.detach(), d_obj.detach(), r_world.detach().amax(1) + CULL_SIGMAS * sigma,

@@ -14,7 +14,7 @@ from radar_cli.model import losses as L
 from radar_cli.model.config import RunConfig
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.lighting import compose, tone_map
-from radar_cli.render.mouth import mouth_coverage
+from radar_cli.render.mouth import coverage, coverage_above, mouth_margin
 from radar_cli.render.raycast import Hits, cast_rays
 from radar_cli.render.scene import Shading, render_front, shade
 
@@ -79,12 +79,13 @@ def _mouth_term(pred: Decomposition, hits: Hits, recon_mu: torch.Tensor, front: 
     is or would be at the largest pitch (so a flatter pose cannot hide the mouth from the term)."""
     m, lc = config.model, config.loss
     size = m.render.image_size
-    mouth = mouth_coverage(pred.radius, pred.height, pred.pose, size, m.camera, lc.mouth_sigma_px)[:, None]
+    margin = mouth_margin(pred.radius, pred.height, pred.pose, size, m.camera)  # B x H x W
+    mouth = coverage(margin, lc.mouth_sigma_px)[:, None]
     with torch.no_grad():
         steepest = pred.pose.detach().clone()
         steepest[:, 0] = m.geometry.pitch_range[1]
-        band = torch.maximum(*(mouth_coverage(pred.radius, pred.height, pose, size, m.camera, 4 * lc.mouth_sigma_px)
-                               for pose in (pred.pose, steepest))) > 0.01
+        widest = torch.maximum(margin, mouth_margin(pred.radius, pred.height, steepest, size, m.camera))
+        band = coverage_above(widest, 4 * lc.mouth_sigma_px, 0.01)
         seen = torch.maximum(front, hits.inner[:, None].to(front.dtype))
         region = batch.mask[:, None] * band[:, None].to(front.dtype) * seen
     return L.mouth_l1(recon_mu, front, mouth, batch.image, region, m.render.inside_dim)
