@@ -94,7 +94,8 @@ def _first(values: torch.Tensor, ray_idx: torch.Tensor, m: int) -> torch.Tensor:
 
 @torch.no_grad()
 def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_idx: torch.Tensor,
-           h: torch.Tensor, s_near: torch.Tensor, s_far: torch.Tensor, deep: float = float("inf")) -> Found:
+           h: torch.Tensor, s_near: torch.Tensor, s_far: torch.Tensor, deep: float = float("inf"),
+           misses: bool = True) -> Found:
     """Exact first hits, mouth exits and minimisers of F = max(rho - r(y), |y| - h) along M rays.
 
     Args:
@@ -105,6 +106,8 @@ def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_
         s_near, s_far: M span of each ray inside the (inflated) bounding cylinder.
         deep: rays whose chord through the solid has F < -deep at its middle skip the exact minimisation of F
             (their soft silhouette is saturated): s_min is that middle point instead.
+        misses: minimise F along the rays that miss too (for their soft silhouette); False skips them, for a
+            caller that only needs the hits (their s_min is then the closest approach to the object's centre).
 
     Returns:
         Found (all M).
@@ -132,13 +135,14 @@ def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_
     hits = _hits(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, flat, b_idx, h, n_rows, -s_c)
     mid = hits.s_min
     inside = hits.hit & (_implicit(ray, mid[:, None], h, flat, b_idx, n_rows)[:, 0] < -deep)
-    keep = ~inside.index_select(0, ray_idx)
-    if not bool(keep.all()):
-        pair = _Ray(*(x[keep] for x in (pair.qa, pair.qb, pair.qc, pair.oy, pair.dy)))
-        ray_idx, alpha, beta, t_lo, t_hi, hp = (x[keep] for x in (ray_idx, alpha, beta, t_lo, t_hi, hp))
+    skip = inside if misses else inside | ~hits.hit  # rays whose s_min is not minimised
+    keep = (~skip.index_select(0, ray_idx)).nonzero()[:, 0]  # one nonzero for all the pair tensors
+    if keep.shape[0] < ray_idx.shape[0]:
+        pair = pair.take(keep)
+        ray_idx, alpha, beta, t_lo, t_hi, hp = (x.index_select(0, keep) for x in (ray_idx, alpha, beta, t_lo, t_hi, hp))
     t_min = _minimiser(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, hp, flat, b_idx, h, n_rows,
-                       (~inside).nonzero()[:, 0])
-    t_min = torch.where(inside, mid, t_min)
+                       (~skip).nonzero()[:, 0])
+    t_min = torch.where(inside, mid, torch.where(skip, torch.zeros_like(mid), t_min))
     s_hit = torch.where(hits.hit, hits.s_hit, t_min) + s_c
     return Found(t_min + s_c, s_hit, hits.hit, hits.inner, hits.cap)
 

@@ -109,6 +109,7 @@ def cast_rays(
     size: int,
     camera: CameraConfig = CameraConfig(),
     sigma_px: float = 1.0,
+    soft_outside: bool = True,
 ) -> Hits:
     """Cast one ray per pixel at a batch of solids of revolution.
 
@@ -119,6 +120,9 @@ def cast_rays(
         size: image side in pixels.
         camera: the fixed camera.
         sigma_px: softness of the soft silhouette in pixels.
+        soft_outside: the soft silhouette off the object too (where training needs it); False sets it to 0 there
+            and skips the search for those rays' closest approach, for renders drawn over a hard mask (synthesis).
+            Hits are unchanged either way.
 
     Returns:
         Hits with H = W = size.
@@ -139,11 +143,13 @@ def cast_rays(
     flat = b_idx * d_obj.shape[1] + p_idx
 
     found = search(rays.o.detach(), rays.d.detach(), r_world.detach(), b_idx, rays.h.detach(),
-                   s_near[b_idx, p_idx], s_far[b_idx, p_idx], deep=DEEP_SIGMAS * sigma)
+                   s_near[b_idx, p_idx], s_far[b_idx, p_idx], deep=DEEP_SIGMAS * sigma, misses=soft_outside)
     g = _margin(rays, found.s_min)  # differentiable margin, world units
     # g is close to the distance from the ray to the solid, ~ pixels * pixel size at the object; the taper
     # takes the soft silhouette to exactly 0 at the culling margin, so it stays continuous in every input
     sil_m = torch.sigmoid(-g / sigma) * (CULL_SIGMAS - g / sigma).clamp(0.0, 1.0)
+    if not soft_outside:
+        sil_m = sil_m * found.hit.to(dt)
 
     s_hit, normals, uv = _surface_at(rays, found, row_slopes(radius, height))
     # the camera sits at the origin: a point at parameter s along pixel p's ray is s * dirs[p] in camera space

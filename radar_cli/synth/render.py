@@ -84,7 +84,7 @@ def render_sample(
     a, p = torch.tensor([alpha], dtype=torch.float32), torch.tensor([rho], dtype=torch.float32)
 
     shading = shade(r, h, v, linear, e, a, p, render, camera, span=FULL_SPAN)
-    hits = cast_rays(r, h, v, size, camera, render.sil_sigma_px)
+    hits = cast_rays(r, h, v, size, camera, render.sil_sigma_px, soft_outside=False)
     image, _ = render_texture(hits, shading.texture, inside_dim=render.inside_dim, background=background)
     albedo_img, _ = render_texture(hits, display, inside_dim=1.0, background=0.0)
     maps = torch.cat([shading.diffuse, shading.specular], dim=1)  # 1 x 2 x Ht x 3Wt
