@@ -36,6 +36,14 @@ class _Canvas:
         self.theta = ((np.arange(width, dtype=np.float32) + 0.5) / width * 2 * math.pi)[None, :]  # 1 x W
         self.v = ((np.arange(height, dtype=np.float32) + 0.5) / height)[:, None]  # H x 1
 
+    def rows(self, v0: float, v1: float) -> tuple[slice, "_Canvas"]:
+        """The rows that a band from v0 to v1 can touch (its anti-aliased edges included), and a canvas of just
+        those rows: same scale (h), so every pattern drawn on it equals the full canvas's rows there."""
+        r0, r1 = max(0, math.floor(v0 * self.h) - 1), min(self.h, math.ceil(v1 * self.h) + 1)
+        sub = _Canvas.__new__(_Canvas)
+        sub.h, sub.w, sub.theta, sub.v = self.h, self.w, self.theta, self.v[r0:r1]
+        return slice(r0, r1), sub
+
 
 def _soft(signed_px: np.ndarray) -> np.ndarray:
     """Coverage from a signed distance in pixels (negative inside), anti-aliased over one pixel."""
@@ -165,25 +173,28 @@ def _pick(rng: np.random.Generator, palette: np.ndarray) -> np.ndarray:
 
 
 def _decorate_bands(tex: np.ndarray, rng: np.random.Generator, c: _Canvas, palette: np.ndarray) -> np.ndarray:
-    """Stack 0..6 decorated horizontal bands (plain, stripes, zigzag, meander, dots, flowers)."""
+    """Stack 0..6 decorated horizontal bands (plain, stripes, zigzag, meander, dots, flowers), each drawn on
+    the rows it covers only (every pattern is 0 outside its band)."""
     for _ in range(int(rng.integers(0, 7))):
         v0 = float(rng.uniform(0.0, 0.9))
         v1 = min(1.0, v0 + float(rng.uniform(0.03, 0.3)))
         kind = int(rng.integers(6))
         colour = _pick(rng, palette)
+        rows, band = c.rows(v0, v1)
+        part = tex[rows]  # a view: blends below paint tex in place
         if kind == 0:
-            tex = _blend(tex, _band(rng, c, v0, v1), colour)
+            _blend(part, _band(rng, band, v0, v1), colour)
         elif kind == 1:
-            tex = _blend(tex, _stripes(rng, c, v0, v1), colour)
+            _blend(part, _stripes(rng, band, v0, v1), colour)
         elif kind == 2:
-            tex = _blend(tex, _zigzag(rng, c, v0, v1), colour)
+            _blend(part, _zigzag(rng, band, v0, v1), colour)
         elif kind == 3:
-            tex = _blend(tex, _meander(rng, c, v0, v1), colour)
+            _blend(part, _meander(rng, band, v0, v1), colour)
         elif kind == 4:
-            tex = _blend(tex, _dots(rng, c, v0, v1), colour)
+            _blend(part, _dots(rng, band, v0, v1), colour)
         else:
-            petals, centres = _flowers(rng, c, v0, v1)
-            tex = _blend(_blend(tex, petals, colour), centres, _pick(rng, palette))
+            petals, centres = _flowers(rng, band, v0, v1)
+            _blend(_blend(part, petals, colour), centres, _pick(rng, palette))
     return tex
 
 

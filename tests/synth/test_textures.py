@@ -51,3 +51,20 @@ def test_texture_folder_errors(tmp_path):
         list_texture_images(tmp_path)
     with pytest.raises(InputError, match="no such texture folder"):
         list_texture_images(tmp_path / "missing")
+
+
+@pytest.mark.parametrize("v0, v1", [(0.0, 0.05), (0.31, 0.52), (0.9, 1.0), (0.5, 0.5 + 1e-4)])
+def test_band_patterns_vanish_outside_the_rows_they_are_drawn_on(v0, v1):
+    """Bands are drawn on Canvas.rows only: every pattern on the full canvas is 0 outside those rows and equal to
+    the sub-canvas's pattern inside them."""
+    from radar_cli.synth import textures as T
+
+    canvas = T._Canvas(64, 192)
+    rows, band = canvas.rows(v0, v1)
+    for draw in (T._band, T._stripes, T._zigzag, T._meander, T._dots, lambda *a: T._flowers(*a)[0]):
+        full = np.broadcast_to(draw(np.random.default_rng(4), canvas, v0, v1), (64, 192))
+        part = np.broadcast_to(draw(np.random.default_rng(4), band, v0, v1), (rows.stop - rows.start, 192))
+        outside = np.ones(64, bool)
+        outside[rows] = False
+        assert float(np.abs(full[outside]).max(initial=0.0)) == 0.0
+        assert np.array_equal(full[rows], part)
