@@ -9,6 +9,7 @@ import importlib
 import click
 
 from radar_cli import __version__
+from radar_cli.allocator import keep_freed_memory
 from radar_cli.errors import RadarError
 
 # (command name, module, attribute, one-line help): one line per working subcommand, in pipeline order.
@@ -64,4 +65,5 @@ def cli() -> None:
 
 def main() -> None:
     """Console-script entry point."""
+    keep_freed_memory()
     cli()

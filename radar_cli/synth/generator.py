@@ -23,6 +23,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
+from radar_cli.allocator import keep_freed_memory
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig, to_dict
 from radar_cli.dataset import IMAGE_FILE, MASK_FILE, SPLITS, SampleRef, sample_ref, write_sample
 from radar_cli.errors import ConfigError, InputError, RadarError
@@ -184,7 +185,9 @@ def _work(job: tuple[SynthConfig, str, str, int, list[Path] | None]) -> tuple[st
 
 
 def _init_worker() -> None:
-    """One thread per worker for torch and OpenCV: the pool is the parallelism (more threads oversubscribe)."""
+    """One thread per worker for torch and OpenCV: the pool is the parallelism (more threads oversubscribe);
+    freed memory kept for reuse (a fresh interpreter does not run the CLI's entry point)."""
+    keep_freed_memory()
     torch.set_num_threads(1)
     cv2.setNumThreads(1)
 
