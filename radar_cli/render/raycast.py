@@ -24,6 +24,7 @@ from radar_cli.render.intersect import Found, search
 from radar_cli.sor.profile import check_sor, row_coordinate, row_slopes
 
 CULL_SIGMAS = 6.0  # rays farther than this many sigmas from the bounding cylinder are not cast (sil = 0)
+HIT_SIGMAS = 0.01  # the margin when only hits are wanted (soft_outside=False): against rounding at the rim
 DEEP_SIGMAS = 10.0  # hits this many sigmas inside skip the exact margin (sil > 0.99995 either way)
 
 
@@ -135,8 +136,8 @@ def cast_rays(
     rot, origin, dirs, d_obj = object_rays(pose, size, camera)
     r_world, h_world = radius * camera.r_max, height * camera.r_max
 
-    s_near, s_far = _span(origin.detach(), d_obj.detach(), r_world.detach().amax(1) + CULL_SIGMAS * sigma,
-                          h_world.detach() + CULL_SIGMAS * sigma)
+    cull = (CULL_SIGMAS if soft_outside else HIT_SIGMAS) * sigma  # bounding-cylinder margin: the soft halo or none
+    s_near, s_far = _span(origin.detach(), d_obj.detach(), r_world.detach().amax(1) + cull, h_world.detach() + cull)
     active = s_far > s_near  # B x P
     b_idx, p_idx = active.nonzero(as_tuple=True)
     rays = _Rays(b_idx, origin[b_idx], d_obj[b_idx, p_idx], r_world, h_world[b_idx])

@@ -52,8 +52,9 @@ def test_silhouette_and_depth_match_trimesh(random_sor):
 
 
 def test_hits_only_search_leaves_every_hit_unchanged(random_sor):
-    """soft_outside=False (synthesis draws over the hard mask) skips the misses' margin search: every output on
-    the object is the same as the full cast's, and the soft silhouette is 0 off it."""
+    """soft_outside=False (synthesis draws over the hard mask) casts only the rays that can hit and skips the
+    misses' margin search: every output on the object is the same as the full cast's (up to float32 rounding:
+    vectorised and scalar exp differ in the last bit), and the soft silhouette is 0 off it."""
     radius, height, pose = random_sor(6, seed=3, dtype=torch.float32)
     full = cast_rays(radius, height, pose, 96, CameraConfig(), 1.0)
     hits_only = cast_rays(radius, height, pose, 96, CameraConfig(), 1.0, soft_outside=False)
@@ -61,6 +62,6 @@ def test_hits_only_search_leaves_every_hit_unchanged(random_sor):
     assert torch.equal(hits_only.mask, on) and torch.equal(hits_only.inner, full.inner)
     for name in ("sil", "depth", "normal", "uv", "points"):
         a, b = getattr(full, name), getattr(hits_only, name)
-        assert torch.equal(a[on], b[on]), name
+        assert torch.allclose(a[on], b[on], rtol=0.0, atol=1e-6), name
     assert float(hits_only.sil[~on].abs().max()) == 0.0
     assert float(full.sil[~on].max()) > 0.4  # the full cast is soft just outside the outline
