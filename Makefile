@@ -8,6 +8,9 @@ RADAR := $(BIN)/radar
 SHARED ?= ../shared
 DEVICE ?= auto
 WORKERS ?= 2
+THREADS ?=
+# CPU training threads: empty keeps each preset's train.threads (1, for shared machines); THREADS=2 on an idle one
+TRAIN_THREADS := $(if $(THREADS),--threads $(THREADS),)
 
 .PHONY: install demo test test-all clean \
         syn-data syn-data-cpu train-syn train-syn-cpu eval-syn eval-syn-cpu table2 table2-cpu \
@@ -63,12 +66,12 @@ syn-data-cpu: $(STAMP)
 
 # The bundled model's three stages: the paper's losses, then a sharp silhouette, then the mouth term.
 train-syn-cpu: $(STAMP)
-	$(RADAR) train --config pipelines/syn_vases_cpu.toml --data data/syn_cpu --out runs/syn_cpu --device cpu
+	$(RADAR) train --config pipelines/syn_vases_cpu.toml --data data/syn_cpu --out runs/syn_cpu --device cpu $(TRAIN_THREADS)
 	$(RADAR) train --config pipelines/syn_vases_cpu_sharp.toml --init runs/syn_cpu/checkpoints/step_0006500.safetensors \
-		--data data/syn_cpu --out runs/syn_cpu_sharp --device cpu
+		--data data/syn_cpu --out runs/syn_cpu_sharp --device cpu $(TRAIN_THREADS)
 	$(RADAR) train --config pipelines/syn_vases_cpu_mouth.toml \
 		--init runs/syn_cpu_sharp/checkpoints/step_0004500.safetensors --data data/syn_cpu --out runs/syn_cpu_mouth \
-		--device cpu
+		--device cpu $(TRAIN_THREADS)
 
 eval-syn-cpu: $(STAMP)
 	$(RADAR) derender data/syn_cpu/test --checkpoint runs/syn_cpu_mouth/model.safetensors --out results/syn_cpu \
@@ -77,7 +80,7 @@ eval-syn-cpu: $(STAMP)
 
 table2-cpu: $(STAMP)
 	for p in syn_vases_cpu syn_vases_cpu_no_alb syn_vases_cpu_no_sad syn_vases_cpu_no_diff syn_vases_cpu_supervised; do \
-		$(RADAR) train --config pipelines/$$p.toml --data data/syn_cpu --out runs/$$p --device cpu && \
+		$(RADAR) train --config pipelines/$$p.toml --data data/syn_cpu --out runs/$$p --device cpu $(TRAIN_THREADS) && \
 		$(RADAR) derender data/syn_cpu/test --checkpoint runs/$$p/model.safetensors --out results/$$p --views 0 && \
 		$(RADAR) eval --pred results/$$p --gt data/syn_cpu --json results/$$p/eval.json || exit 1; \
 	done

@@ -21,13 +21,15 @@ from radar_cli.model.config import load_run_config
 @click.option("--iterations", type=click.IntRange(min=0), default=None, help="Overrides train.iterations.")
 @click.option("--init", "init", type=click.Path(dir_okay=False), default=None,
               help="Start from the weights of this checkpoint or model file (fine-tuning; fresh optimizers).")
+@click.option("--threads", type=click.IntRange(min=1), default=None,
+              help="Overrides train.threads (CPU threads; the CPU presets use 1 for shared machines).")
 def train(config_path: str, data_dir: str, run_dir: str, resume: bool, device: str | None, overfit: int | None,
-          iterations: int | None, init: str | None) -> None:
+          iterations: int | None, init: str | None, threads: int | None) -> None:
     """Train the de-rendering model (shape, lighting, albedo networks + SAD discriminator)."""
     from radar_cli.train.trainer import train as run_training
 
     summary = run_training(load_run_config(config_path), data_dir, run_dir, resume=resume, device=device,
-                           overfit=overfit, iterations=iterations, init=init)
+                           overfit=overfit, iterations=iterations, init=init, threads=threads)
     losses = "  ".join(f"{k}={v:.4f}" for k, v in summary.losses.items())
     click.echo(f"trained steps {summary.start}..{summary.end} in {summary.seconds:.1f} s "
                f"({summary.sec_per_step:.3f} s/step)")

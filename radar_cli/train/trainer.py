@@ -116,11 +116,14 @@ def _resume(run_dir: Path, config: RunConfig, state: TrainState) -> int:
     return restore(ckpts[-1], config, state)
 
 
-def apply_overrides(config: RunConfig, iterations: int | None, overfit: int | None) -> RunConfig:
-    """The config with --iterations replaced and, for --overfit N, the batch size limited to N."""
+def apply_overrides(config: RunConfig, iterations: int | None, overfit: int | None,
+                    threads: int | None = None) -> RunConfig:
+    """The config with --iterations and --threads replaced and, for --overfit N, the batch size limited to N."""
     train = config.train
     if iterations is not None:
         train = dataclasses.replace(train, iterations=iterations)
+    if threads is not None:
+        train = dataclasses.replace(train, threads=threads)
     if overfit is not None:
         train = dataclasses.replace(train, batch_size=min(train.batch_size, overfit))
     return dataclasses.replace(config, train=train).validate()
@@ -128,7 +131,7 @@ def apply_overrides(config: RunConfig, iterations: int | None, overfit: int | No
 
 def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: bool = False,
           device: str | None = None, overfit: int | None = None, iterations: int | None = None,
-          progress: bool = True, init: str | Path | None = None) -> TrainSummary:
+          progress: bool = True, init: str | Path | None = None, threads: int | None = None) -> TrainSummary:
     """Train RADAR on DATA/train and write checkpoints, metrics and images to run_dir.
 
     Args:
@@ -142,6 +145,7 @@ def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: 
         progress: show the progress bar.
         init: start from this checkpoint's weights (fine-tuning); ignored when resuming a run that has
             checkpoints of its own.
+        threads: CPU threads (overrides config.train.threads).
 
     Returns:
         TrainSummary.
@@ -150,7 +154,7 @@ def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: 
         DivergedError: NaN/Inf in an output, loss or gradient (the step number and last checkpoint are named).
         CheckpointError, InputError, ConfigError: unusable checkpoint, data or config.
     """
-    config = apply_overrides(config, iterations, overfit)
+    config = apply_overrides(config, iterations, overfit, threads)
     info = D.setup(device or config.train.device)
     if config.train.threads > 0:
         torch.set_num_threads(config.train.threads)

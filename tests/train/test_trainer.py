@@ -115,3 +115,12 @@ def test_nan_weights_stop_with_step(vases32, tmp_path, monkeypatch):
     monkeypatch.setattr(trainer, "train_step", poison_then_step)
     with pytest.raises(DivergedError, match="step 1: invalid network output"):
         train(tiny_config(iterations=3), vases32, tmp_path / "run", progress=False)
+
+
+def test_command_line_overrides_replace_only_what_they_name():
+    cfg = tiny_config()
+    out = trainer.apply_overrides(cfg, iterations=7, overfit=None, threads=2)
+    assert (out.train.iterations, out.train.threads, out.train.batch_size) == (7, 2, cfg.train.batch_size)
+    assert out.model == cfg.model and out.loss == cfg.loss
+    same = trainer.apply_overrides(cfg, None, None)
+    assert same.train == cfg.train
