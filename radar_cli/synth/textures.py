@@ -8,6 +8,7 @@ top of the vase (0) to the bottom. Everything is drawn from a numpy Generator: s
 
 from __future__ import annotations
 
+import copy
 import math
 from pathlib import Path
 
@@ -40,8 +41,8 @@ class _Canvas:
         """The rows that a band from v0 to v1 can touch (its anti-aliased edges included), and a canvas of just
         those rows: same scale (h), so every pattern drawn on it equals the full canvas's rows there."""
         r0, r1 = max(0, math.floor(v0 * self.h) - 1), min(self.h, math.ceil(v1 * self.h) + 1)
-        sub = _Canvas.__new__(_Canvas)
-        sub.h, sub.w, sub.theta, sub.v = self.h, self.w, self.theta, self.v[r0:r1]
+        sub = copy.copy(self)
+        sub.v = self.v[r0:r1]  # (r1 - r0) x 1
         return slice(r0, r1), sub
 
 
