@@ -29,6 +29,7 @@ GRID_COLUMNS = ("input", "reconstruction", "albedo", "diffuse", "specular", "nor
                 "mask", "predicted silhouette", "S~ (loss region)")
 _COLORS = [(31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40), (148, 103, 189), (140, 86, 75),
            (227, 119, 194), (127, 127, 127)]
+NOT_LOSSES = ("step", "sec_per_step", "lr")  # metrics.jsonl fields kept off the progress bar and the loss curve
 
 
 def read_metrics(run_dir: str | Path) -> list[dict]:
@@ -69,7 +70,7 @@ class RunLogger:
         self.bar.update(1)
         if not self.enabled or values is None:
             return
-        self.bar.set_postfix({k: f"{v:.4f}" for k, v in values.items() if k != "sec_per_step"}, refresh=False)
+        self.bar.set_postfix({k: f"{v:.4f}" for k, v in values.items() if k not in NOT_LOSSES}, refresh=False)
         self.metrics.write(json.dumps({"step": step, **values}) + "\n")
         self.metrics.flush()
         if self.writer is not None:
@@ -139,7 +140,7 @@ def loss_curve(records: list[dict], width: int = 900, height: int = 500) -> np.n
     """Every loss term against the step, log10 scale, drawn with PIL (no matplotlib). Returns H x W x 3 uint8."""
     img = Image.new("RGB", (width, height), "white")
     draw = ImageDraw.Draw(img)
-    keys = [k for k in (records[0] if records else {}) if k not in ("step", "sec_per_step")]
+    keys = [k for k in (records[0] if records else {}) if k not in NOT_LOSSES]
     pts = {k: [(r["step"], math.log10(max(r[k], 1e-8))) for r in records if k in r and math.isfinite(r[k])]
            for k in keys}
     allp = [p for v in pts.values() for p in v]

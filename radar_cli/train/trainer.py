@@ -15,7 +15,7 @@ from pathlib import Path
 import torch
 
 from radar_cli.errors import InputError, RadarError
-from radar_cli.model.config import RunConfig
+from radar_cli.model.config import RunConfig, TrainConfig
 from radar_cli.model.discriminator import PatchDiscriminator
 from radar_cli.model.losses import sad_discriminator_loss
 from radar_cli.model.radar import RadarModel
@@ -65,6 +65,14 @@ def build_state(config: RunConfig, device: torch.device) -> TrainState:
                       torch.optim.Adam(disc.parameters(), t.lr, betas))
 
 
+def learning_rate(t: TrainConfig, step: int) -> float:
+    """The learning rate of step `step` (0-based): t.lr, decayed linearly to 0 over the last t.lr_decay_steps."""
+    left = t.iterations - step
+    if t.lr_decay_steps == 0 or left >= t.lr_decay_steps:
+        return t.lr
+    return t.lr * max(0, left) / t.lr_decay_steps
+
+
 def uses_sad(config: RunConfig) -> bool:
     return not config.loss.no_sad and not config.loss.supervised
 
@@ -85,6 +93,9 @@ def train_step(state: TrainState, model: torch.nn.Module, disc: torch.nn.Module,
     """One optimisation step of the model and, with L_SAD, of D. `model`/`disc` may be DDP wrappers of
     state.model/state.disc. Returns (loss terms as floats, prediction, rendered) of this rank's batch."""
     step = state.step
+    lr = learning_rate(config.train, step)  # a function of the step alone, so a resumed run follows the same curve
+    for group in state.opt_model.param_groups + state.opt_disc.param_groups:
+        group["lr"] = lr
     try:
         pred = model(batch.image)
     except InputError as e:  # the geometry checks inside forward reject NaN shapes before we see them
@@ -195,6 +206,7 @@ def _run(config: RunConfig, data_dir: Path, run_dir: Path, resume: bool, overfit
             values = dict(D.mean_across(terms, info)) if logged else None
             if values is not None:
                 values["sec_per_step"] = time.perf_counter() - tic
+                values["lr"] = learning_rate(t, step)
             logger.step(step, values)
             if done % t.image_every == 0 or done == t.iterations:
                 logger.grid(done, batch, pred, rendered, config.model.render.gamma)

@@ -124,3 +124,16 @@ def test_command_line_overrides_replace_only_what_they_name():
     assert out.model == cfg.model and out.loss == cfg.loss
     same = trainer.apply_overrides(cfg, None, None)
     assert same.train == cfg.train
+
+
+def test_learning_rate_decays_linearly_over_the_last_steps(vases32, tmp_path):
+    t = tiny_config(iterations=6, lr_decay_steps=4).train
+    assert [trainer.learning_rate(t, s) / t.lr for s in range(6)] == [1, 1, 1, 0.75, 0.5, 0.25]
+    assert trainer.learning_rate(tiny_config(iterations=6).train, 5) == t.lr  # 0 = constant, as the paper
+    summary = train(tiny_config(iterations=6, lr_decay_steps=4), vases32, tmp_path / "run", progress=False)
+    records = [json.loads(line) for line in (tmp_path / "run" / "metrics.jsonl").read_text().splitlines()]
+    assert [r["lr"] / t.lr for r in records] == pytest.approx([1, 1, 1, 0.75, 0.5, 0.25])
+    groups = summary.state.opt_model.param_groups + summary.state.opt_disc.param_groups
+    assert all(g["lr"] == pytest.approx(0.25 * t.lr) for g in groups)
+    with pytest.raises(RadarError, match="lr_decay_steps"):
+        tiny_config(iterations=6, lr_decay_steps=7)
