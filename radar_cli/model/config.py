@@ -99,7 +99,8 @@ class TrainConfig:
 
     lr: float = 2e-4
     lr_decay_steps: int = 0
-    """Decay the learning rate linearly to 0 over the last N iterations (0 = constant, as in the paper)."""
+    """Decay the learning rate linearly to 0 over the last N iterations (0 = constant, as in the paper); a run
+    shorter than N (e.g. --iterations) starts part-way down the ramp."""
     beta1: float = 0.9
     beta2: float = 0.999
     batch_size: int = 24
@@ -136,8 +137,8 @@ class RunConfig:
             raise ConfigError(f"loss.sad_group_fraction must lie in (0, 0.5], got {self.loss.sad_group_fraction}")
         if self.train.batch_size < 1 or self.train.iterations < 0 or self.train.keep_checkpoints < 1:
             raise ConfigError("train.batch_size and train.keep_checkpoints must be >= 1, iterations >= 0")
-        if not 0 <= self.train.lr_decay_steps <= self.train.iterations:
-            raise ConfigError(f"train.lr_decay_steps must lie in [0, iterations], got {self.train.lr_decay_steps}")
+        if self.train.lr_decay_steps < 0:
+            raise ConfigError(f"train.lr_decay_steps must be >= 0, got {self.train.lr_decay_steps}")
         return self
 
 

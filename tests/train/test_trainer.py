@@ -35,11 +35,23 @@ def test_outputs_of_a_run(vases32, tmp_path):
     assert [p.name for p in list_checkpoints(run)] == ["step_0000002.safetensors", "step_0000004.safetensors"]
 
 
-def test_resume_continues_exactly(vases32, tmp_path):
-    full = train(tiny_config(iterations=6, checkpoint_every=3), vases32, tmp_path / "a", progress=False)
-    train(tiny_config(iterations=3, checkpoint_every=3), vases32, tmp_path / "b", progress=False)
-    resumed = train(tiny_config(iterations=6, checkpoint_every=3), vases32, tmp_path / "b", resume=True,
-                    progress=False)
+@pytest.mark.parametrize("decay", [0, 4])  # with lr_decay_steps, the killed run stops inside the decay
+def test_resume_continues_exactly(vases32, tmp_path, monkeypatch, decay):
+    full = train(tiny_config(iterations=6, checkpoint_every=3, lr_decay_steps=decay), vases32, tmp_path / "a",
+                 progress=False)
+    real_step = trainer.train_step
+
+    def killed_after_three(state, *args):
+        if state.step == 3:
+            raise KeyboardInterrupt  # as a kill after the step-3 checkpoint
+        return real_step(state, *args)
+
+    with monkeypatch.context() as patch, pytest.raises(KeyboardInterrupt):
+        patch.setattr(trainer, "train_step", killed_after_three)
+        train(tiny_config(iterations=6, checkpoint_every=3, lr_decay_steps=decay), vases32, tmp_path / "b",
+              progress=False)
+    resumed = train(tiny_config(iterations=6, checkpoint_every=3, lr_decay_steps=decay), vases32, tmp_path / "b",
+                    resume=True, progress=False)
     assert resumed.start == 3 and resumed.end == 6
     for a, b in zip(full.history[3:], resumed.history):
         assert a.keys() == b.keys()
@@ -135,5 +147,6 @@ def test_learning_rate_decays_linearly_over_the_last_steps(vases32, tmp_path):
     assert [r["lr"] / t.lr for r in records] == pytest.approx([1, 1, 1, 0.75, 0.5, 0.25])
     groups = summary.state.opt_model.param_groups + summary.state.opt_disc.param_groups
     assert all(g["lr"] == pytest.approx(0.25 * t.lr) for g in groups)
+    assert trainer.learning_rate(tiny_config(iterations=2, lr_decay_steps=4).train, 0) == 0.5 * t.lr
     with pytest.raises(RadarError, match="lr_decay_steps"):
-        tiny_config(iterations=6, lr_decay_steps=7)
+        tiny_config(iterations=6, lr_decay_steps=-1)
