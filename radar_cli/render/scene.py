@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import torch
 import torch.nn.functional as F
@@ -30,13 +31,20 @@ class Shading:
         diffuse: B x 1 x Ht x Wt diffuse factor I_d (linear).
         specular: B x 1 x Ht x Wt specular factor I_s (linear, before rho).
         texture: B x 3 x Ht x Wt tone-mapped shaded texture T = tau(A * I_d + rho * I_s).
-        normals: B x 3 x Ht x Wt camera-space unit normals at the texels (upsampled from the shading grid).
+        grid_normals: B x rows x cols x 3 camera-space unit normals on the shading grid.
     """
 
     diffuse: torch.Tensor
     specular: torch.Tensor
     texture: torch.Tensor
-    normals: torch.Tensor
+    grid_normals: torch.Tensor
+
+    @cached_property
+    def normals(self) -> torch.Tensor:
+        """B x 3 x Ht x Wt camera-space unit normals at the texels, upsampled from the shading grid on first use
+        (synthesis never reads them)."""
+        normals = upsample(self.grid_normals.permute(0, 3, 1, 2), tuple(self.texture.shape[-2:]))
+        return normals / normals.norm(dim=1, keepdim=True).clamp_min(1e-6)
 
 
 def shade(
@@ -78,10 +86,8 @@ def shade(
     size = (dims["Ht"], dims["Wt"])
     diffuse = upsample(diffuse[:, None], size)
     specular = upsample(specular[:, None], size)
-    normals = upsample(grid.normals.permute(0, 3, 1, 2), size)
-    normals = normals / normals.norm(dim=1, keepdim=True).clamp_min(1e-6)
     texture = compose(albedo, diffuse, specular, rho, render.gamma)
-    return Shading(diffuse, specular, texture, normals)
+    return Shading(diffuse, specular, texture, grid.normals)
 
 
 def render_front(hits: Hits, texture: torch.Tensor, background: float = 0.0) -> tuple[torch.Tensor, torch.Tensor]:
