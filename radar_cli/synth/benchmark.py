@@ -23,7 +23,6 @@ def bench_synth(size: int, n: int, workers: int, shading_size: int = 0, seed: in
         (single process, one thread, the median of STAGE_SAMPLES samples), and the settings.
     """
     cfg = SynthConfig(size=size, seed=seed, shading_size=shading_size)
-    render = cfg.render_config()
     with tempfile.TemporaryDirectory(prefix="radar-bench-synth-") as tmp:
         summary = generate(Path(tmp) / "pool", {"test": n}, cfg, workers=workers, progress=False)
         make_s, write_s = _stage_times(cfg, Path(tmp) / "stages")
@@ -31,7 +30,7 @@ def bench_synth(size: int, n: int, workers: int, shading_size: int = 0, seed: in
         "size": size,
         "samples": n,
         "workers": workers,
-        "shading_grid": [render.shading_height, 3 * render.shading_width],
+        "shading_grid": cfg.grids()["shading"],
         "samples_per_sec": round(summary.rate, 2),
         "failed": len(summary.failed),
         "sec_per_sample_make": round(make_s, 4),

@@ -66,6 +66,12 @@ class SynthConfig:
         return RenderConfig(image_size=self.size, tex_height=tex, tex_width=tex, shading_height=shading,
                             shading_width=shading)
 
+    def grids(self) -> dict[str, list[int]]:
+        """The effective [rows, columns over the full turn] of the albedo map and of the lighting grid."""
+        render = self.render_config()
+        return {"tex": [render.tex_height, 3 * render.tex_width],
+                "shading": [render.shading_height, 3 * render.shading_width]}
+
     def check(self) -> None:
         """Raise ConfigError on values outside the supported ranges."""
         if not 16 <= self.size <= MAX_SIZE:
@@ -195,10 +201,8 @@ def _init_worker() -> None:
 def _check_settings(root: Path, cfg: SynthConfig) -> None:
     """Write DATA/synth.json, or check that an existing one matches (a resumed run must not mix settings)."""
     path = root / layout.SETTINGS_FILE
-    render = cfg.render_config()  # the effective grids, so a changed default cannot mix two kinds of sample
-    settings = {"format_version": FORMAT_VERSION, **to_dict(cfg),
-                "effective": {"tex": [render.tex_height, 3 * render.tex_width],
-                              "shading": [render.shading_height, 3 * render.shading_width]}}
+    # the effective grids too, so a changed default cannot mix two kinds of sample
+    settings = {"format_version": FORMAT_VERSION, **to_dict(cfg), "effective": cfg.grids()}
     if path.is_file():
         try:
             old = json.loads(path.read_text(encoding="utf-8"))
