@@ -60,6 +60,9 @@ CHUNK_ELEMENTS = 1 << 18  # B x samples x lights per chunk: bounds the B x N x E
 # cache-sized: measured 2x faster than 16 MiB chunks on the CPU)
 KEEP_ELEMENTS = 1 << 25  # up to this B x N x E the forward's chunks are kept for backward (4 x 128 MiB in float32)
 # instead of recomputed; larger problems (64 x 64 grids at batch 24) recompute to keep memory flat
+GPU_CHUNK_ELEMENTS = 1 << 24  # on a GPU, cache-sized chunks mean thousands of tiny kernel launches per step (the
+# paper preset spent 40 ms a step launching them on an H100): 64 MiB chunks, a handful per call
+GPU_KEEP_ELEMENTS = 1 << 28  # and keep up to 4 x 1 GiB for backward rather than recompute
 BIG = 1e30  # step(x) = clamp(x * BIG, 0, 1): a 0/1 mask in two cheap passes (a comparison + masked_fill is ~15x
 # slower on the CPU); it differs from x > 0 only for 0 < x < 1e-30
 
@@ -108,7 +111,8 @@ class _Phong(torch.autograd.Function):
     def forward(ctx, n, p, radiance, alpha, dirs):
         step = _chunk(n, dirs)
         rad = radiance[..., None]  # B x E x 1
-        keep = any(ctx.needs_input_grad) and n.shape[0] * n.shape[1] * dirs.shape[0] <= KEEP_ELEMENTS
+        keep_limit = GPU_KEEP_ELEMENTS if n.is_cuda else KEEP_ELEMENTS
+        keep = any(ctx.needs_input_grad) and n.shape[0] * n.shape[1] * dirs.shape[0] <= keep_limit
         diffuse, lobe_sum, ctx.chunks = [], [], []
         for i in range(0, n.shape[1], step):
             if not keep:
@@ -159,8 +163,8 @@ class _Phong(torch.autograd.Function):
 
 
 def _chunk(n: torch.Tensor, dirs: torch.Tensor) -> int:
-    """Samples per chunk so one B x chunk x E tensor holds about CHUNK_ELEMENTS values."""
-    return max(1, CHUNK_ELEMENTS // max(1, n.shape[0] * dirs.shape[0]))
+    """Samples per chunk so one B x chunk x E tensor holds about CHUNK_ELEMENTS (GPU_CHUNK_ELEMENTS) values."""
+    return max(1, (GPU_CHUNK_ELEMENTS if n.is_cuda else CHUNK_ELEMENTS) // max(1, n.shape[0] * dirs.shape[0]))
 
 
 def tone_map(x: torch.Tensor, gamma: float = GAMMA) -> torch.Tensor:
