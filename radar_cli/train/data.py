@@ -64,7 +64,10 @@ def read_params(ref: SampleRef) -> dict | None:
 
 
 class VaseDataset(Dataset):
-    """All samples of one split in memory: item i -> dict(image 3xSxS float [0,1], mask SxS, dt SxS)."""
+    """All samples of one split in memory: item i -> dict(image 3xSxS uint8, mask SxS bool, dt SxS float).
+
+    Items stay in their compact types until `to_batch` has moved them to the device: fewer bytes to collate and
+    copy (a 256 px batch of 24 collated in 9-16 ms as float32, 6 ms as uint8, on a 2-core CPU)."""
 
     def __init__(self, root: str | Path, split: str, size: int, limit: int | None = None, workers: int = 4):
         refs = list_samples(root, split)
@@ -91,8 +94,7 @@ class VaseDataset(Dataset):
         return len(self.refs)
 
     def __getitem__(self, i: int) -> dict:
-        return {"index": i, "image": self.images[i].float() / 255.0, "mask": self.masks[i].float(),
-                "dt": self.dts[i]}
+        return {"index": i, "image": self.images[i], "mask": self.masks[i], "dt": self.dts[i]}
 
 
 class StepBatchSampler(Sampler[list[int]]):
@@ -132,8 +134,9 @@ def make_loader(dataset: VaseDataset, sampler: StepBatchSampler) -> DataLoader:
 
 
 def to_batch(items: dict, device: torch.device, target: Decomposition | None = None) -> Batch:
-    """A collated DataLoader dict as a Batch on `device`."""
-    return Batch(items["image"].to(device), items["mask"].to(device), items["dt"].to(device), target)
+    """A collated DataLoader dict (B x 3 x S x S uint8 images, B x S x S bool masks) as a float Batch on `device`."""
+    image = items["image"].to(device).float() / 255.0
+    return Batch(image, items["mask"].to(device).float(), items["dt"].to(device), target)
 
 
 def _target_maps(ref: SampleRef, tex: tuple[int, int], env: tuple[int, int], gamma: float):
