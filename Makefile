@@ -12,7 +12,7 @@ THREADS ?=
 # CPU training threads: empty keeps each preset's train.threads (1, for shared machines); THREADS=2 on an idle one
 TRAIN_THREADS := $(if $(THREADS),--threads $(THREADS),)
 
-.PHONY: install demo test test-all clean \
+.PHONY: install demo test test-all test-gpu clean \
         syn-data syn-data-cpu train-syn train-syn-cpu eval-syn eval-syn-cpu table2 table2-cpu \
         met-fetch met-masks train-met real-vases bench
 
@@ -35,6 +35,10 @@ test: $(STAMP)
 
 test-all: $(STAMP)
 	$(BIN)/python -m pytest -q tests
+
+# CPU-vs-CUDA agreement of the renderer, the losses and the bundled model (each test skips without CUDA)
+test-gpu: $(STAMP)
+	$(BIN)/python -m pytest -q -m gpu tests
 
 clean:
 	rm -rf $(VENV) demo_out .pytest_cache
