@@ -40,11 +40,15 @@ def render(device: str, sizes: str, batch: int, repeats: int, threads: int) -> N
 @click.option("--warmup", default=2, show_default=True, type=click.IntRange(min=0), help="Untimed first steps.")
 @click.option("--batch", default=None, type=click.IntRange(min=1), help="Batch size (default: the preset's).")
 @click.option("--threads", default=None, type=click.IntRange(min=1), help="CPU threads (default: the preset's).")
-def train(config_path: str, device: str, steps: int, warmup: int, batch: int | None, threads: int | None) -> None:
+@click.option("--profile", "profile_path", default=None, type=click.Path(dir_okay=False),
+              help="Also write torch.profiler's operator tables of 3 more steps to this text file.")
+def train(config_path: str, device: str, steps: int, warmup: int, batch: int | None, threads: int | None,
+          profile_path: str | None) -> None:
     """Seconds per full training step (model + discriminator, forward, backward, Adam) and peak memory."""
     from radar_cli.train.benchmark import bench_train
 
-    click.echo(json.dumps(bench_train(config_path, steps, warmup, batch, device, threads), indent=2))
+    result = bench_train(config_path, steps, warmup, batch, device, threads, profile_path)
+    click.echo(json.dumps(result, indent=2))
 
 
 @bench.command("masks")

@@ -5,9 +5,11 @@ from __future__ import annotations
 import resource
 import time
 from pathlib import Path
+from typing import Callable
 
 import torch
 
+from radar_cli.fileio import write_text
 from radar_cli.model.config import RunConfig, load_run_config
 from radar_cli.model.losses import distance_transform
 from radar_cli.train import distributed as D
@@ -15,7 +17,9 @@ from radar_cli.train.step import Batch
 from radar_cli.train.trainer import build_state, train_step
 
 
-def _batch(config: RunConfig, batch_size: int, device: torch.device) -> Batch:
+def elliptic_batch(config: RunConfig, batch_size: int, device: torch.device) -> Batch:
+    """Random B x 3 x S x S images with one elliptic B x S x S mask (and its distance transform): the work of a
+    training step without a dataset."""
     size = config.model.render.image_size
     c = (torch.arange(size) + 0.5) / size * 2 - 1
     yy, xx = torch.meshgrid(c, c, indexing="ij")
@@ -26,7 +30,7 @@ def _batch(config: RunConfig, batch_size: int, device: torch.device) -> Batch:
 
 
 def bench_train(config: RunConfig | str | Path, steps: int = 5, warmup: int = 2, batch_size: int | None = None,
-                device: str = "auto", threads: int | None = None) -> dict:
+                device: str = "auto", threads: int | None = None, profile: str | Path | None = None) -> dict:
     """Time full training steps (model + D forward, backward, Adam) of a preset.
 
     Args:
@@ -35,6 +39,8 @@ def bench_train(config: RunConfig | str | Path, steps: int = 5, warmup: int = 2,
         batch_size: overrides train.batch_size.
         device: "auto", "cpu" or "cuda".
         threads: torch CPU threads (default: the preset's train.threads, else torch's default).
+        profile: also profile 3 more steps with torch.profiler and write its operator tables (by own CPU time, and
+            on a GPU by own GPU time with the kernel launches and synchronisations per step) to this text file.
 
     Returns:
         {"preset", "device", "batch_size", "image_size", "threads", "sec_per_step", "steps_per_sec",
@@ -45,16 +51,17 @@ def bench_train(config: RunConfig | str | Path, steps: int = 5, warmup: int = 2,
     dev = D.pick_device(device)
     n_threads = threads if threads is not None else (config.train.threads or torch.get_num_threads())
     with D.torch_threads(n_threads):
-        sec, peak = _time_steps(config, batch_size or config.train.batch_size, dev, steps, warmup)
+        sec, peak = _time_steps(config, batch_size or config.train.batch_size, dev, steps, warmup, profile)
     return {"preset": config.name, "device": str(dev), "batch_size": batch_size or config.train.batch_size,
             "image_size": config.model.render.image_size, "threads": n_threads, "sec_per_step": round(sec, 4),
             "steps_per_sec": round(1 / sec, 3), "peak_memory_mb": round(peak, 1), "steps": steps}
 
 
-def _time_steps(config: RunConfig, bs: int, dev: torch.device, steps: int, warmup: int) -> tuple[float, float]:
-    """Median seconds per step and peak memory in MiB."""
+def _time_steps(config: RunConfig, bs: int, dev: torch.device, steps: int, warmup: int,
+                profile: str | Path | None) -> tuple[float, float]:
+    """Median seconds per step and peak memory in MiB (and the profile, when asked, after the timed steps)."""
     state = build_state(config, dev)
-    batch = _batch(config, bs, dev)
+    batch = elliptic_batch(config, bs, dev)
     info = D.DistInfo(0, 1, dev)
     if dev.type == "cuda":
         torch.cuda.reset_peak_memory_stats(dev)
@@ -71,4 +78,32 @@ def _time_steps(config: RunConfig, bs: int, dev: torch.device, steps: int, warmu
         peak = torch.cuda.max_memory_allocated(dev) / 2**20
     else:
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # KiB on Linux
+    if profile is not None:
+        _write_profile(Path(profile), lambda: train_step(state, state.model, state.disc, batch, config, info,
+                                                         Path(".")), dev)
     return sec, peak
+
+
+PROFILED_STEPS = 3
+
+
+def _write_profile(path: Path, step: Callable[[], object], dev: torch.device) -> None:
+    """torch.profiler over PROFILED_STEPS calls of `step`: operator tables as text, written atomically."""
+    from torch.profiler import ProfilerActivity, profile
+
+    activities = [ProfilerActivity.CPU] + ([ProfilerActivity.CUDA] if dev.type == "cuda" else [])
+    with profile(activities=activities) as prof:
+        for _ in range(PROFILED_STEPS):
+            step()
+        if dev.type == "cuda":
+            torch.cuda.synchronize(dev)
+    table = prof.key_averages()
+    text = f"# torch.profiler, {PROFILED_STEPS} training steps on {dev}\n"
+    if dev.type == "cuda":
+        launches = sum(e.count for e in table if e.key in ("cudaLaunchKernel", "cudaLaunchKernelExC"))
+        syncs = sum(e.count for e in table if e.key == "cudaStreamSynchronize")
+        text += (f"# per step: {launches / PROFILED_STEPS:.0f} kernel launches, {syncs / PROFILED_STEPS:.0f} stream "
+                 f"synchronisations\n\n# by own GPU time\n"
+                 + table.table(sort_by="self_cuda_time_total", row_limit=40, max_name_column_width=60))
+    text += "\n# by own CPU time\n" + table.table(sort_by="self_cpu_time_total", row_limit=30, max_name_column_width=60)
+    write_text(path, text)

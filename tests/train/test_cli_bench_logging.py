@@ -63,6 +63,14 @@ def test_bench_train_reports_speed_and_memory():
     assert out["sec_per_step"] > 0 and out["peak_memory_mb"] > 0 and out["batch_size"] == 4
 
 
+def test_bench_train_writes_a_profile(tmp_path):
+    path = tmp_path / "profile.txt"
+    bench_train(tiny_config(), steps=1, warmup=0, device="cpu", threads=1, profile=path)
+    text = path.read_text()
+    assert text.startswith("# torch.profiler, 3 training steps on cpu") and "aten::convolution" in text
+    assert "# by own CPU time" in text
+
+
 def test_loss_curve_draws_every_term():
     records = [{"step": s, "total": 1.0 / (s + 1), "sil": 0.5, "sec_per_step": 0.1} for s in range(20)]
     image = loss_curve(records)

@@ -15,7 +15,7 @@ from radar_cli.model.config import RunConfig
 from radar_cli.train.step import generator_losses
 from radar_cli.train.trainer import build_state, train_step
 from radar_cli.train import distributed as D
-from radar_cli.train.benchmark import _batch
+from radar_cli.train.benchmark import elliptic_batch
 
 from .conftest import tiny_config
 
@@ -43,7 +43,7 @@ def test_losses_agree_on_cpu_and_cuda():
     for name in ("cpu", "cuda"):
         dev = torch.device(name)
         state = build_state(config, dev)  # seeded: identical weights on both devices
-        batch = _batch(config, 4, dev)
+        batch = elliptic_batch(config, 4, dev)
         pred = state.model(batch.image)
         terms[name], _ = generator_losses(pred, batch, config, state.disc)
         terms[name]["radius"] = pred.radius.sum()
@@ -59,7 +59,7 @@ def test_cuda_steps_lower_the_loss():
     config = _config()
     dev = torch.device("cuda")
     state = build_state(config, dev)
-    batch = _batch(config, 4, dev)
+    batch = elliptic_batch(config, 4, dev)
     info = D.DistInfo(0, 1, dev)
     totals = [train_step(state, state.model, state.disc, batch, config, info, Path("."))[0]["total"] for _ in range(12)]
     assert all(np.isfinite(totals))
