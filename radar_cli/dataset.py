@@ -89,5 +89,10 @@ def read_sample(ref: SampleRef) -> tuple[np.ndarray, np.ndarray]:
 
 def write_sample(ref: SampleRef, image: np.ndarray, mask: np.ndarray, png_level: int = PNG_LEVEL) -> None:
     """Write a sample's image (H x W x 3, float [0,1] or uint8) and mask (H x W bool); atomic per file."""
-    write_image(ref.image_path, image, png_level)
-    write_image(ref.mask_path, (mask > 0.5).astype(np.uint8) * 255, png_level)
+    for name, array in sample_images(image, mask).items():
+        write_image(ref.folder / name, array, png_level)
+
+
+def sample_images(image: np.ndarray, mask: np.ndarray) -> dict[str, np.ndarray]:
+    """{IMAGE_FILE: the image as given, MASK_FILE: H x W uint8 0/255}: what a sample folder holds."""
+    return {IMAGE_FILE: image, MASK_FILE: (mask > 0.5).astype(np.uint8) * 255}

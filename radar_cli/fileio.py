@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import tempfile
@@ -47,14 +48,24 @@ def write_text(path: str | Path, text: str) -> None:
 
 def write_json(path: str | Path, obj: Any) -> None:
     """Write an object as indented JSON atomically."""
-    write_text(path, json.dumps(obj, indent=2, sort_keys=True) + "\n")
+    write_bytes(path, encode_json(obj))
+
+
+def encode_json(obj: Any) -> bytes:
+    """An object as radar's JSON files hold it: indented, sorted keys, UTF-8, a final newline."""
+    return (json.dumps(obj, indent=2, sort_keys=True) + "\n").encode("utf-8")
 
 
 def write_npy(path: str | Path, array: np.ndarray) -> None:
     """Write a numpy array atomically."""
-    with atomic_path(path) as tmp:
-        with open(tmp, "wb") as f:
-            np.save(f, array)
+    write_bytes(path, encode_npy(array))
+
+
+def encode_npy(array: np.ndarray) -> bytes:
+    """A numpy array as the bytes of a .npy file."""
+    buffer = io.BytesIO()
+    np.save(buffer, array)
+    return buffer.getvalue()
 
 
 def to_uint8(image: np.ndarray) -> np.ndarray:
@@ -69,12 +80,16 @@ FAST_PNG_LEVEL = 1  # for bulk writers (radar synth): 2.5x faster to encode, fil
 def write_image(path: str | Path, image: np.ndarray, png_level: int = PNG_LEVEL) -> None:
     """Write an image atomically; float arrays are taken as [0, 1], uint8 as is. H x W or H x W x {3,4}.
     png_level: zlib compression level 0-9 when the file is a PNG."""
+    write_bytes(path, encode_image(image, _format_for(Path(path)), png_level))
+
+
+def encode_image(image: np.ndarray, fmt: str = "PNG", png_level: int = PNG_LEVEL) -> bytes:
+    """The bytes of an image file (PIL format name, e.g. "PNG"); float arrays are taken as [0, 1], uint8 as is."""
     if image.dtype != np.uint8:
         image = to_uint8(image)
-    fmt = _format_for(Path(path))
-    options = {"compress_level": png_level} if fmt == "PNG" else {}
-    with atomic_path(path) as tmp:
-        Image.fromarray(image).save(tmp, format=fmt, **options)
+    buffer = io.BytesIO()
+    Image.fromarray(image).save(buffer, format=fmt, **({"compress_level": png_level} if fmt == "PNG" else {}))
+    return buffer.getvalue()
 
 
 def _format_for(path: Path) -> str:

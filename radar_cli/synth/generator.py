@@ -25,9 +25,9 @@ from tqdm import tqdm
 
 from radar_cli.allocator import keep_freed_memory
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig, to_dict
-from radar_cli.dataset import IMAGE_FILE, MASK_FILE, SPLITS, SampleRef, sample_ref, write_sample
+from radar_cli.dataset import IMAGE_FILE, MASK_FILE, SPLITS, sample_images, sample_ref
 from radar_cli.errors import ConfigError, InputError, RadarError
-from radar_cli.fileio import FAST_PNG_LEVEL, write_image, write_json, write_npy, write_text
+from radar_cli.fileio import FAST_PNG_LEVEL, encode_image, encode_json, encode_npy, write_json, write_text
 from radar_cli.synth import layout
 from radar_cli.synth.lighting import bake_env, sample_lobes
 from radar_cli.synth.render import env_preview, render_sample
@@ -156,18 +156,21 @@ def make_sample(cfg: SynthConfig, split: str, index: int, textures: list[Path] |
 
 def write_sample_folder(root: Path, split: str, sid: str, files: dict, params: dict) -> None:
     """Write one sample into a temporary folder under DATA/.partial, then rename it into place, so readers
-    of the split never see half a sample."""
+    of the split never see half a sample. The folder is the unit of atomicity: its files are written directly,
+    without a temporary file and rename each (that cost 3-10 ms of a sample's ~25 ms of writing)."""
     final = sample_ref(root, split, sid).folder
     tmp = root / PARTIAL_DIR / f"{split}-{sid}-{os.getpid()}"
     shutil.rmtree(tmp, ignore_errors=True)
     tmp.mkdir(parents=True)
-    write_sample(SampleRef(tmp.parent, "", tmp.name), files.pop(IMAGE_FILE), files.pop(MASK_FILE), FAST_PNG_LEVEL)
+    files = dict(files)
+    files.update(sample_images(files.pop(IMAGE_FILE), files.pop(MASK_FILE)))
     for name, arr in files.items():
         if name.endswith(".npy"):
-            write_npy(tmp / name, arr)
+            data = encode_npy(arr)
         else:
-            write_image(tmp / name, arr.astype(np.uint8) * 255 if arr.dtype == bool else arr, FAST_PNG_LEVEL)
-    write_json(tmp / layout.PARAMS_FILE, params)
+            data = encode_image(arr.astype(np.uint8) * 255 if arr.dtype == bool else arr, "PNG", FAST_PNG_LEVEL)
+        (tmp / name).write_bytes(data)
+    (tmp / layout.PARAMS_FILE).write_bytes(encode_json(params))
     if final.exists():  # an unfinished folder from an older run
         shutil.rmtree(final)
     final.parent.mkdir(parents=True, exist_ok=True)
