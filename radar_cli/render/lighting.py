@@ -61,8 +61,8 @@ CHUNK_ELEMENTS = 1 << 18  # B x samples x lights per chunk: bounds the B x N x E
 KEEP_ELEMENTS = 1 << 25  # up to this B x N x E the forward's chunks are kept for backward (4 x 128 MiB in float32)
 # instead of recomputed; larger problems (64 x 64 grids at batch 24) recompute to keep memory flat
 GPU_CHUNK_ELEMENTS = 1 << 24  # on a GPU, cache-sized chunks mean thousands of tiny kernel launches per step (the
-# paper preset's step launched ~12k for Phong alone and took 0.46 s on an H100, 0.08-0.10 s with these): 64 MiB
-# chunks, a handful per call
+# paper preset's step launched ~12k for Phong alone and took 0.46 s on an H100; 0.08-0.10 s with these and
+# the ray caster's index_select gathers): 64 MiB chunks, a handful per call
 GPU_KEEP_ELEMENTS = 1 << 28  # and keep up to 4 x 1 GiB for backward rather than recompute
 BIG = 1e30  # step(x) = clamp(x * BIG, 0, 1): a 0/1 mask in two cheap passes (a comparison + masked_fill is ~15x
 # slower on the CPU); it differs from x > 0 only for 0 < x < 1e-30
