@@ -162,8 +162,7 @@ def write_sample_folder(root: Path, split: str, sid: str, files: dict, params: d
     tmp = root / PARTIAL_DIR / f"{split}-{sid}-{os.getpid()}"
     shutil.rmtree(tmp, ignore_errors=True)
     tmp.mkdir(parents=True)
-    files = dict(files)
-    files.update(sample_images(files.pop(IMAGE_FILE), files.pop(MASK_FILE)))
+    files = {**files, **sample_images(files[IMAGE_FILE], files[MASK_FILE])}  # the mask as the dataset stores it
     for name, arr in files.items():
         if name.endswith(".npy"):
             data = encode_npy(arr)
