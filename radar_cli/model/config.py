@@ -81,6 +81,11 @@ class LossConfig:
     """Weight of L_alb carried into the open mouth (losses.mouth_l1; 0 = off, the paper). Needs L_alb."""
     mouth_sigma_px: float = 1.0
     """Softness of the mouth's rim for that term, in pixels; it is scored within 4x this of the rim."""
+    cycle_weight: float = 0.0
+    """Weight of the shape cycle (radar's addition; 0 = off, the paper): the prediction, re-rendered whole at a
+    random pitch over the input's background, must give back its own radius, height and pose, pitch included
+    (step.shape_cycle_term). The pitch of that render is known exactly, so f_S learns to read pitch from images
+    drawn the way the data is."""
     sad_patch: int = 64
     """Side of the albedo patches shown to the discriminator (a power of two >= 8)."""
     sad_patches_per_image: int = 4
@@ -133,6 +138,8 @@ class RunConfig:
             raise ConfigError(f"loss.sad_patch must be a power of two in [8, texture size], got {p}")
         if self.loss.mouth_weight < 0 or self.loss.mouth_sigma_px <= 0:
             raise ConfigError("loss.mouth_weight must be >= 0 and loss.mouth_sigma_px > 0")
+        if self.loss.cycle_weight < 0:
+            raise ConfigError(f"loss.cycle_weight must be >= 0, got {self.loss.cycle_weight}")
         if not 0 < self.loss.sad_group_fraction <= 0.5:
             raise ConfigError(f"loss.sad_group_fraction must lie in (0, 0.5], got {self.loss.sad_group_fraction}")
         if self.train.batch_size < 1 or self.train.iterations < 0 or self.train.keep_checkpoints < 1:

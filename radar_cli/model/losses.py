@@ -155,6 +155,28 @@ def _unit(x: torch.Tensor, lo: float, hi: float) -> torch.Tensor:
     return (x - lo) / (hi - lo)
 
 
+def geometry_l1(pred: tuple[torch.Tensor, ...], target: tuple[torch.Tensor, ...],
+                ranges: dict[str, tuple[float, float]]) -> dict[str, torch.Tensor]:
+    """L1 of a shape and pose against a target, each value mapped to [0, 1] by its range.
+
+    Args:
+        pred, target: (radius B x L, height B, pose B x 4).
+        ranges: (lo, hi) for "radius", "height", "pitch", "roll", "trans".
+
+    Returns:
+        Dict of scalar terms: radius, height, pose.
+    """
+    (radius, height, pose), (t_radius, t_height, t_pose) = pred, target
+    pose_lo = torch.tensor([ranges["pitch"][0], ranges["roll"][0], ranges["trans"][0], ranges["trans"][0]])
+    pose_hi = torch.tensor([ranges["pitch"][1], ranges["roll"][1], ranges["trans"][1], ranges["trans"][1]])
+    pose_lo, pose_hi = pose_lo.to(pose), pose_hi.to(pose)
+    return {
+        "radius": (_unit(radius, *ranges["radius"]) - _unit(t_radius, *ranges["radius"])).abs().mean(),
+        "height": (_unit(height, *ranges["height"]) - _unit(t_height, *ranges["height"])).abs().mean(),
+        "pose": ((pose - t_pose) / (pose_hi - pose_lo)).abs().mean(),
+    }
+
+
 def supervised_loss(pred: Decomposition, target: Decomposition, ranges: dict[str, tuple[float, float]]) -> dict:
     """The supervised baseline of Table 2: L1 of every output against ground truth, each mapped to [0, 1] by
     its range so the terms weigh alike.
@@ -166,13 +188,10 @@ def supervised_loss(pred: Decomposition, target: Decomposition, ranges: dict[str
     Returns:
         Dict of scalar terms: radius, height, pose, albedo, env, alpha, rho.
     """
-    pose_lo = torch.tensor([ranges["pitch"][0], ranges["roll"][0], ranges["trans"][0], ranges["trans"][0]])
-    pose_hi = torch.tensor([ranges["pitch"][1], ranges["roll"][1], ranges["trans"][1], ranges["trans"][1]])
-    pose_lo, pose_hi = pose_lo.to(pred.pose), pose_hi.to(pred.pose)
+    geometry = geometry_l1((pred.radius, pred.height, pred.pose), (target.radius, target.height, target.pose),
+                           ranges)
     return {
-        "radius": (_unit(pred.radius, *ranges["radius"]) - _unit(target.radius, *ranges["radius"])).abs().mean(),
-        "height": (_unit(pred.height, *ranges["height"]) - _unit(target.height, *ranges["height"])).abs().mean(),
-        "pose": ((pred.pose - target.pose) / (pose_hi - pose_lo)).abs().mean(),
+        **geometry,
         "albedo": (pred.albedo - target.albedo).abs().mean(),
         "env": (_unit(pred.env, *ranges["env"]) - _unit(target.env, *ranges["env"])).abs().mean(),
         "alpha": (_unit(pred.alpha, *ranges["alpha"]) - _unit(target.alpha, *ranges["alpha"])).abs().mean(),

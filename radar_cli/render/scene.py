@@ -103,6 +103,22 @@ def render_front(hits: Hits, texture: torch.Tensor, background: float = 0.0) -> 
     return render_texture(hits, texture, front_only=True, background=background)
 
 
+def draw_over_background(hits: Hits, texture: torch.Tensor, inside_dim: float,
+                         background: float | torch.Tensor) -> torch.Tensor:
+    """A full 360 deg map drawn as `radar synth` draws its images: anti-aliased by the soft silhouette within the
+    hard one and the plain background everywhere off it (no soft halo outside the object).
+
+    Args:
+        hits: ray casting of B images (soft_outside=False suffices). texture: B x C x Ht x 3Wt.
+        background: a grey level, or B x C x 1 x 1 colours.
+
+    Returns:
+        B x C x H x W.
+    """
+    image, hard = render_texture(hits, texture, front_only=False, inside_dim=inside_dim, background=background)
+    return image * hard + background * (1 - hard)
+
+
 def rotate_full_map(texture: torch.Tensor, yaw_deg: float) -> torch.Tensor:
     """Spin a 360 deg map about the axis: the content at angle phi moves to phi + yaw (B x C x Ht x 3Wt)."""
     width = texture.shape[-1]

@@ -35,7 +35,7 @@ def render_texture(
     texture: torch.Tensor,
     front_only: bool = False,
     inside_dim: float = 0.5,
-    background: float = 0.0,
+    background: float | torch.Tensor = 0.0,
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """Render a texture map onto the image through the ray-casting result.
 
@@ -44,7 +44,7 @@ def render_texture(
         texture: B x C x Ht x Wt' map; a frontal third if front_only, otherwise a full 360 deg map.
         front_only: render only the frontal third of the outer surface (for L_im); other pixels get background.
         inside_dim: brightness factor for the inside of the vase (full renders).
-        background: value of pixels without surface.
+        background: value of pixels without surface (a number, or a tensor broadcasting to B x C x 1 x 1).
 
     Returns:
         image: B x C x H x W; full renders are blended over the background by the soft silhouette, so they are

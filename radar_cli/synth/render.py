@@ -15,7 +15,7 @@ import torch
 from radar_cli.config import CameraConfig, RenderConfig
 from radar_cli.render.lighting import TINY, power, tone_map
 from radar_cli.render.raycast import cast_rays
-from radar_cli.render.scene import shade
+from radar_cli.render.scene import draw_over_background, shade
 from radar_cli.render.texture import render_texture
 from radar_cli.sor.surface import FULL_SPAN
 
@@ -85,14 +85,13 @@ def render_sample(
 
     shading = shade(r, h, v, linear, e, a, p, render, camera, span=FULL_SPAN)
     hits = cast_rays(r, h, v, size, camera, render.sil_sigma_px, soft_outside=False)
-    image, _ = render_texture(hits, shading.texture, inside_dim=render.inside_dim, background=background)
+    image = draw_over_background(hits, shading.texture, render.inside_dim, background)
     albedo_img, _ = render_texture(hits, display, inside_dim=1.0, background=0.0)
     maps = torch.cat([shading.diffuse, shading.specular], dim=1)  # 1 x 2 x Ht x 3Wt
     maps_img, _ = render_texture(hits, maps, inside_dim=1.0, background=0.0)
     ones = torch.ones_like(display[:, :1])
     _, front = render_texture(hits, ones[..., : ones.shape[-1] // 3], front_only=True)
     hard = hits.mask[:, None].to(torch.float32)
-    image = image * hard + background * (1 - hard)  # no soft-silhouette halo: plain background off the object
     return RenderedSample(
         image=np.clip(_hwc(image), 0.0, 1.0),
         mask=hits.mask[0].numpy().copy(),

@@ -16,7 +16,9 @@ from radar_cli.model.outputs import Decomposition
 from radar_cli.render.lighting import compose, tone_map
 from radar_cli.render.mouth import coverage, coverage_above, mouth_margin
 from radar_cli.render.raycast import Hits, cast_rays
-from radar_cli.render.scene import Shading, render_front, shade
+from radar_cli.render.scene import Shading, draw_over_background, render_front, shade
+from radar_cli.render.texture import full_from_front
+from radar_cli.sor.surface import FULL_SPAN
 
 
 @dataclass(frozen=True)
@@ -91,8 +93,49 @@ def _mouth_term(pred: Decomposition, hits: Hits, recon_mu: torch.Tensor, front: 
     return L.mouth_l1(recon_mu, front, mouth, batch.image, region, m.render.inside_dim)
 
 
-def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig,
-                     disc: nn.Module | None) -> tuple[dict[str, torch.Tensor], Rendered]:
+def background_colour(image: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+    """Mean colour of each image off its silhouette (B x 3 x H x W, B x H x W 0/1) -> B x 3 x 1 x 1."""
+    off = (1 - mask)[:, None]
+    return (image * off).sum(dim=(2, 3), keepdim=True) / off.sum(dim=(2, 3), keepdim=True).clamp_min(1.0)
+
+
+@torch.no_grad()
+def redraw(pred: Decomposition, pose: torch.Tensor, background: torch.Tensor, config: RunConfig) -> torch.Tensor:
+    """A prediction drawn whole from another pose, the way `radar synth` draws its images: the frontal albedo
+    mirrored round the back, shaded over the full 360 deg, the inside dimmed, over a plain background, quantised
+    to 8 bits.
+
+    Args:
+        pred: B objects. pose: B x 4. background: B x 3 x 1 x 1.
+
+    Returns:
+        B x 3 x H x W tone-mapped image in [0, 1].
+    """
+    m = config.model
+    albedo = full_from_front(pred.albedo)  # B x 3 x Ht x 3Wt
+    shading = shade(pred.radius, pred.height, pose, albedo, pred.env, pred.alpha, pred.rho, m.render, m.camera,
+                    span=FULL_SPAN)
+    hits = cast_rays(pred.radius, pred.height, pose, m.render.image_size, m.camera, m.render.sil_sigma_px,
+                     soft_outside=False)
+    image = draw_over_background(hits, shading.texture, m.render.inside_dim, background)
+    return (image.clamp(0.0, 1.0) * 255).round() / 255
+
+
+def shape_cycle_term(shape_net: nn.Module, pred: Decomposition, batch: Batch, config: RunConfig) -> torch.Tensor:
+    """The shape cycle (radar's addition; loss.cycle_weight): redraw the prediction at a pitch drawn uniformly
+    from the model's range (the global RNG, reseeded every step) and ask f_S for its radius, height and pose
+    back (geometry_l1 against what was drawn). Only f_S learns from it; the redrawn image carries no gradient."""
+    target = pred.detach()
+    lo, hi = config.model.geometry.pitch_range
+    pose = target.pose.clone()
+    pose[:, 0] = lo + (hi - lo) * torch.rand(pose.shape[0]).to(pose)
+    image = redraw(target, pose, background_colour(batch.image, batch.mask), config)
+    terms = L.geometry_l1(shape_net(image), (target.radius, target.height, pose), geometry_ranges(config))
+    return sum(terms.values())
+
+
+def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig, disc: nn.Module | None,
+                     shape_net: nn.Module | None = None) -> tuple[dict[str, torch.Tensor], Rendered]:
     """Every loss term of the model (not of D) and their weighted sum under the key "total".
 
     Args:
@@ -100,9 +143,10 @@ def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig,
         batch: the batch.
         config: the run's configuration (weights, switches).
         disc: the bare SAD discriminator (used with frozen weights), or None when L_SAD is off.
+        shape_net: the model's f_S (bare module), for the shape cycle; needed when loss.cycle_weight > 0.
 
     Returns:
-        (losses, rendered): scalar tensors keyed sil, im, alb, diff, sad (those enabled) and total.
+        (losses, rendered): scalar tensors keyed sil, im, alb, mouth, diff, sad, cycle (those enabled) and total.
     """
     lc, render = config.loss, config.model.render
     hits, shading, recon, front = render_prediction(pred, config)
@@ -137,5 +181,10 @@ def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig,
                                       lc.sad_patches_per_image, lc.sad_group_fraction)
         terms["sad"] = L.sad_generator_loss(disc, fake)
         total = total + lc.sad_weight * terms["sad"]
+    if lc.cycle_weight > 0:
+        if shape_net is None:
+            raise ValueError("loss.cycle_weight > 0 needs the model's shape_net")
+        terms["cycle"] = shape_cycle_term(shape_net, pred, batch, config)
+        total = total + lc.cycle_weight * terms["cycle"]
     terms["total"] = total
     return terms, Rendered(hits, shading, recon, front, real, fake)

@@ -6,8 +6,10 @@ import pytest
 import torch
 
 from radar_cli.config import GeometryConfig, RenderConfig
-from radar_cli.train.distributed import torch_threads
 from radar_cli.model.config import LossConfig, ModelConfig, RunConfig, TrainConfig
+from radar_cli.model.losses import distance_transform
+from radar_cli.train.distributed import torch_threads
+from radar_cli.train.step import Batch
 
 
 def tiny_config(**loss) -> RunConfig:
@@ -19,6 +21,15 @@ def tiny_config(**loss) -> RunConfig:
     train = TrainConfig(batch_size=4, iterations=4, checkpoint_every=2, keep_checkpoints=2, image_every=2,
                         log_every=1, device="cpu")
     return RunConfig(name="tiny", model=model, loss=LossConfig(sad_patch=8, **loss), train=train).validate()
+
+
+def box_batch(n: int, rows: slice = slice(6, 26), cols: slice = slice(10, 22)) -> Batch:
+    """n random 32 px images whose target silhouette is one box (the current torch RNG draws the images)."""
+    image = torch.rand(n, 3, 32, 32)
+    mask = torch.zeros(n, 32, 32)
+    mask[:, rows, cols] = 1
+    dts = torch.stack([torch.from_numpy(distance_transform(m.numpy() > 0)) for m in mask])
+    return Batch(image, mask, dts)
 
 
 @pytest.fixture

@@ -12,9 +12,9 @@ from radar_cli.model.radar import RadarModel
 from radar_cli.render.lighting import compose, tone_map
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_front, shade
-from radar_cli.train.step import Batch, generator_losses
+from radar_cli.train.step import generator_losses
 
-from .conftest import tiny_config
+from .conftest import box_batch, tiny_config
 
 
 def test_distance_transform_reference():
@@ -66,11 +66,7 @@ def setup():
     config = tiny_config()
     model = RadarModel(config.model)
     disc = PatchDiscriminator(config.loss.sad_patch, 8, 32)
-    image = torch.rand(4, 3, 32, 32)
-    mask = torch.zeros(4, 32, 32)
-    mask[:, 6:26, 10:22] = 1
-    dts = torch.stack([torch.from_numpy(L.distance_transform(m.numpy() > 0)) for m in mask])
-    return config, model, disc, Batch(image, mask, dts)
+    return config, model, disc, box_batch(4)
 
 
 def _terms(setup):

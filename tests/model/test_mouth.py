@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import torch
 
-from radar_cli.config import CameraConfig, RenderConfig
+from radar_cli.config import RenderConfig
 from radar_cli.errors import ConfigError
 from radar_cli.model import losses as L
 from radar_cli.model.radar import RadarModel
@@ -16,9 +16,9 @@ from radar_cli.render.mouth import mouth_coverage
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_front, render_view, shade
 from radar_cli.synth.shapes import sample_shape
-from radar_cli.train.step import Batch, generator_losses
+from radar_cli.train.step import generator_losses
 
-from .conftest import tiny_config
+from .conftest import box_batch, tiny_config
 
 RENDER = RenderConfig(image_size=64, tex_height=32, tex_width=32, env_height=8, env_width=24, shading_height=16,
                       shading_width=16)
@@ -64,14 +64,11 @@ def test_mouth_term_in_the_training_losses():
     torch.manual_seed(0)
     config = tiny_config(mouth_weight=2.0)
     model = RadarModel(config.model)
-    image = torch.rand(2, 3, 32, 32)
-    mask = torch.zeros(2, 32, 32)
-    mask[:, 4:28, 8:24] = 1
-    dts = torch.stack([torch.from_numpy(L.distance_transform(m.numpy() > 0)) for m in mask])
-    terms, _ = generator_losses(model(image), Batch(image, mask, dts), config, None)
+    batch = box_batch(2, slice(4, 28), slice(8, 24))
+    terms, _ = generator_losses(model(batch.image), batch, config, None)
     assert torch.isfinite(terms["mouth"]) and terms["mouth"].item() >= 0
     expected = (terms["sil"] + terms["im"] + terms["alb"] + 2.0 * terms["mouth"] + terms["diff"])
     assert torch.allclose(terms["total"], expected)
-    assert "mouth" not in generator_losses(model(image), Batch(image, mask, dts), tiny_config(), None)[0]
+    assert "mouth" not in generator_losses(model(batch.image), batch, tiny_config(), None)[0]
     with pytest.raises(ConfigError, match="mouth"):
         tiny_config(mouth_weight=-1.0)

@@ -1,4 +1,5 @@
-"""DistributedDataParallel: 2 CPU processes on gloo under torchrun end a few steps with identical weights."""
+"""DistributedDataParallel: 2 CPU processes on gloo under torchrun end a few steps with identical weights (every
+loss term on, the shape cycle included: its second pass through f_S runs outside DDP's forward)."""
 
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ from .conftest import tiny_config
 REPO = Path(__file__).resolve().parents[2]
 
 SCRIPT = textwrap.dedent('''
-    import os, sys
+    import dataclasses, os, sys
     import torch
     from safetensors.torch import save_file
     sys.path.insert(0, sys.argv[3])
@@ -27,7 +28,9 @@ SCRIPT = textwrap.dedent('''
     from radar_cli.train.trainer import train
 
     torch.set_num_threads(1)
-    summary = train(tiny_config(iterations=3), sys.argv[1], sys.argv[2], progress=False)
+    config = tiny_config(iterations=3)
+    config = dataclasses.replace(config, loss=dataclasses.replace(config.loss, cycle_weight=1.0))
+    summary = train(config, sys.argv[1], sys.argv[2], progress=False)
     rank = os.environ["RANK"]
     state = {k: v.contiguous() for k, v in summary.state.model.state_dict().items()}
     state.update({"disc." + k: v.contiguous() for k, v in summary.state.disc.state_dict().items()})

@@ -1,0 +1,113 @@
+"""The shape cycle (loss.cycle_weight): the redraw is the synthetic image, and only f_S learns from the term."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from radar_cli.errors import ConfigError
+from radar_cli.model import losses as L
+from radar_cli.model.outputs import Decomposition
+from radar_cli.model.radar import RadarModel
+from radar_cli.render.lighting import tone_map
+from radar_cli.render.texture import full_from_front
+from radar_cli.synth.render import render_sample
+from radar_cli.train.step import background_colour, generator_losses, redraw
+
+from .conftest import box_batch, tiny_config
+
+
+def _vase(config) -> Decomposition:
+    """One hand-made vase with a painted frontal albedo, a two-lobe light and a glossy material."""
+    r = config.model.render
+    rows = config.model.geometry.n_rows
+    y = torch.linspace(0, 1, rows)
+    radius = (0.45 + 0.25 * torch.sin(3.0 * y) - 0.2 * y**2)[None]  # 1 x L
+    v = torch.linspace(0, 1, r.tex_height)[:, None]
+    u = torch.linspace(0, 1, r.tex_width)[None, :]
+    albedo = torch.stack([0.2 + 0.6 * v.expand(-1, r.tex_width), 0.5 + 0.4 * torch.sin(9 * u + 4 * v),
+                          0.3 + 0.2 * torch.cos(7 * v) * u])[None].clamp(0.05, 0.95)  # 1 x 3 x Ht x Wt linear
+    env = torch.full((1, r.env_height, r.env_width), 0.05)
+    env[0, 0, r.env_width // 2] = 2.0
+    env[0, 1, r.env_width // 3] = 1.0
+    return Decomposition(radius, torch.tensor([0.8]), torch.tensor([[12.0, 2.0, 0.03, -0.02]]), albedo, env,
+                         torch.tensor([40.0]), torch.tensor([0.6]))
+
+
+def test_redraw_is_the_image_radar_synth_draws():
+    """The cycle's input is drawn exactly as the training data: same pixels as synth.render_sample given the
+    mirrored albedo (up to the 8-bit quantisation the dataset's PNGs also have)."""
+    config = tiny_config()
+    m = config.model
+    vase = _vase(config)
+    display = tone_map(full_from_front(vase.albedo), m.render.gamma)[0].permute(1, 2, 0).numpy()  # Ht x 3Wt x 3
+    sample = render_sample(vase.radius[0].numpy(), 0.8, tuple(vase.pose[0].tolist()), display, vase.env[0].numpy(),
+                           40.0, 0.6, m.render.image_size, m.render, m.camera, background=0.9)
+    got = redraw(vase, vase.pose, torch.full((1, 3, 1, 1), 0.9), config)[0].permute(1, 2, 0).numpy()
+    assert sample.mask.sum() > 100 and (sample.image[~sample.mask] == np.float32(0.9)).all()
+    np.testing.assert_allclose(got, sample.image, atol=0.5 / 255 + 1e-4)
+    assert np.array_equal(got, np.round(got * 255) / 255)  # quantised like a PNG
+
+
+def test_background_colour_is_the_mean_off_the_mask():
+    image = torch.zeros(2, 3, 4, 4)
+    image[0, :, :, :2] = 1.0  # left half white
+    mask = torch.zeros(2, 4, 4)
+    mask[0, :, 2:] = 1.0  # the object covers the right half: the background is all white
+    image[1, 0] = 0.5
+    got = background_colour(image, mask)
+    assert got.shape == (2, 3, 1, 1)
+    assert torch.allclose(got[0].flatten(), torch.ones(3))
+    assert torch.allclose(got[1].flatten(), torch.tensor([0.5, 0.0, 0.0]))
+
+
+def test_geometry_l1_reference():
+    ranges = {"radius": (0.0, 1.0), "height": (0.5, 1.0), "pitch": (0.0, 20.0), "roll": (-10.0, 10.0),
+              "trans": (-0.2, 0.2)}
+    pred = (torch.full((1, 4), 0.5), torch.tensor([0.75]), torch.tensor([[10.0, 0.0, 0.0, 0.0]]))
+    target = (torch.full((1, 4), 0.25), torch.tensor([1.0]), torch.tensor([[15.0, 2.0, 0.1, 0.0]]))
+    got = L.geometry_l1(pred, target, ranges)
+    assert got["radius"].item() == pytest.approx(0.25)
+    assert got["height"].item() == pytest.approx(0.5)
+    assert got["pose"].item() == pytest.approx((0.25 + 0.1 + 0.25 + 0) / 4)
+    assert all(v.item() == 0 for v in L.geometry_l1(pred, pred, ranges).values())
+
+
+@pytest.fixture
+def setup():
+    torch.manual_seed(0)
+    config = tiny_config(cycle_weight=2.0)
+    model = RadarModel(config.model)
+    return config, model, box_batch(4)
+
+
+def test_cycle_trains_only_the_shape_network(setup):
+    config, model, batch = setup
+    terms, _ = generator_losses(model(batch.image), batch, config, None, model.shape_net)
+    cycle = terms["cycle"]
+    assert torch.isfinite(cycle) and cycle.item() > 0
+    cycle.backward()
+    grads = {name for name in ("shape_net", "light_net", "albedo_net")
+             if any(p.grad is not None and p.grad.abs().sum() > 0 for p in getattr(model, name).parameters())}
+    assert grads == {"shape_net"}
+
+
+def test_cycle_is_weighted_into_the_total(setup):
+    config, model, batch = setup
+    torch.manual_seed(5)
+    pred = model(batch.image)
+    terms, _ = generator_losses(pred, batch, config, None, model.shape_net)
+    rest = sum(v for k, v in terms.items() if k not in ("cycle", "total"))
+    assert torch.allclose(terms["total"], rest + 2.0 * terms["cycle"])
+    torch.manual_seed(5)  # the redrawn pitch comes from the global RNG: same seed, same term
+    again, _ = generator_losses(model(batch.image), batch, config, None, model.shape_net)
+    assert again["cycle"].item() == terms["cycle"].item()
+    with pytest.raises(ValueError, match="shape_net"):
+        generator_losses(pred, batch, config, None)
+    assert "cycle" not in generator_losses(pred, batch, tiny_config(), None, model.shape_net)[0]
+
+
+def test_negative_cycle_weight_is_rejected():
+    with pytest.raises(ConfigError, match="cycle_weight"):
+        tiny_config(cycle_weight=-1.0)
