@@ -103,20 +103,36 @@ def render_front(hits: Hits, texture: torch.Tensor, background: float = 0.0) -> 
     return render_texture(hits, texture, front_only=True, background=background)
 
 
-def draw_over_background(hits: Hits, texture: torch.Tensor, inside_dim: float,
-                         background: float | torch.Tensor) -> torch.Tensor:
-    """A full 360 deg map drawn as `radar synth` draws its images: anti-aliased by the soft silhouette within the
-    hard one and the plain background everywhere off it (no soft halo outside the object).
+def render_synthetic(
+    radius: torch.Tensor,
+    height: torch.Tensor,
+    pose: torch.Tensor,
+    albedo_full: torch.Tensor,
+    env: torch.Tensor,
+    alpha: torch.Tensor,
+    rho: torch.Tensor,
+    size: int,
+    render: RenderConfig,
+    camera: CameraConfig,
+    background: float | torch.Tensor,
+) -> tuple[torch.Tensor, Hits, Shading]:
+    """The whole object drawn as `radar synth` draws its images: shaded over the full 360 deg, the inside dimmed,
+    anti-aliased by the soft silhouette within the hard one and the plain background everywhere off it (no soft
+    halo outside the object). Synthesis and the training's shape cycle both draw through this.
 
     Args:
-        hits: ray casting of B images (soft_outside=False suffices). texture: B x C x Ht x 3Wt.
-        background: a grey level, or B x C x 1 x 1 colours.
+        radius: B x L; height: B; pose: B x 4.
+        albedo_full: B x 3 x Ht x 3Wt linear 360 deg albedo. env: B x He x We; alpha, rho: B.
+        size: image side in pixels. background: a grey level, or B x 3 x 1 x 1 colours.
 
     Returns:
-        B x C x H x W.
+        (image B x 3 x H x W tone-mapped, the hits (soft silhouette on the object only), the shading).
     """
-    image, hard = render_texture(hits, texture, front_only=False, inside_dim=inside_dim, background=background)
-    return image * hard + background * (1 - hard)
+    shading = shade(radius, height, pose, albedo_full, env, alpha, rho, render, camera, span=FULL_SPAN)
+    hits = cast_rays(radius, height, pose, size, camera, render.sil_sigma_px, soft_outside=False)
+    image, hard = render_texture(hits, shading.texture, front_only=False, inside_dim=render.inside_dim,
+                                 background=background)
+    return image * hard + background * (1 - hard), hits, shading
 
 
 def rotate_full_map(texture: torch.Tensor, yaw_deg: float) -> torch.Tensor:

@@ -16,9 +16,8 @@ from radar_cli.model.outputs import Decomposition
 from radar_cli.render.lighting import compose, tone_map
 from radar_cli.render.mouth import coverage, coverage_above, mouth_margin
 from radar_cli.render.raycast import Hits, cast_rays
-from radar_cli.render.scene import Shading, draw_over_background, render_front, shade
+from radar_cli.render.scene import Shading, render_front, render_synthetic, shade
 from radar_cli.render.texture import full_from_front
-from radar_cli.sor.surface import FULL_SPAN
 
 
 @dataclass(frozen=True)
@@ -113,12 +112,8 @@ def redraw(pred: Decomposition, pose: torch.Tensor, background: torch.Tensor, co
         B x 3 x H x W tone-mapped image in [0, 1].
     """
     m = config.model
-    albedo = full_from_front(pred.albedo)  # B x 3 x Ht x 3Wt
-    shading = shade(pred.radius, pred.height, pose, albedo, pred.env, pred.alpha, pred.rho, m.render, m.camera,
-                    span=FULL_SPAN)
-    hits = cast_rays(pred.radius, pred.height, pose, m.render.image_size, m.camera, m.render.sil_sigma_px,
-                     soft_outside=False)
-    image = draw_over_background(hits, shading.texture, m.render.inside_dim, background)
+    image, _, _ = render_synthetic(pred.radius, pred.height, pose, full_from_front(pred.albedo), pred.env,
+                                   pred.alpha, pred.rho, m.render.image_size, m.render, m.camera, background)
     return (image.clamp(0.0, 1.0) * 255).round() / 255
 
 
