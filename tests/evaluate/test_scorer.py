@@ -11,7 +11,8 @@ from click.testing import CliRunner
 
 from radar_cli.cli import cli
 from radar_cli.evaluate.from_truth import Perturbation, results_from_synth
-from radar_cli.evaluate.scorer import PAPER_TABLE2, evaluate, markdown_table, pitch_calibration, report_json
+from radar_cli.evaluate.scorer import (PAPER_TABLE2, SampleScore, constant_baseline, constant_env_errors, evaluate,
+                                      markdown_table, pitch_calibration, report_json)
 from radar_cli.results import ResultPaths
 from radar_cli.synth.generator import SynthConfig, generate
 
@@ -119,3 +120,40 @@ def test_table_reports_pitch_calibration(synth_set, tmp_path):
     report = evaluate(tmp_path, synth_set, progress=False)
     assert report.summary()["pitch_calibration"]["slope"] == pytest.approx(1.0, abs=1e-6)
     assert "Pitch calibration (predicted vs true): slope 1.00, correlation 1.00" in markdown_table(report)
+
+
+def _score(pitch: float, alpha: float, rho: float) -> SampleScore:
+    return SampleScore(id="x", pitch=0.0, normal=0.0, albedo=0.0, alpha=0.0, rho=0.0, env=0.0,
+                       albedo_no_decomposition=0.0, region_px=1, pitch_pred=0.0, pitch_true=pitch, alpha_true=alpha,
+                       rho_true=rho)
+
+
+def test_constant_baseline_hand_computed():
+    # truths 2, 4, 12 -> median 4 -> errors 2, 0, 8: mean 10/3
+    scores = [_score(2.0, 10.0, 0.1), _score(4.0, 100.0, 0.5), _score(12.0, 190.0, 0.6)]
+    got = constant_baseline(scores, [0.5, 1.5])
+    assert got["pitch"]["mean"] == pytest.approx(10.0 / 3.0)
+    assert got["pitch"]["rmse"] == pytest.approx(np.sqrt((4.0 + 0.0 + 64.0) / 3.0))
+    assert got["alpha"]["mean"] == pytest.approx(180.0 / 3.0)  # 90, 0, 90
+    assert got["rho"]["mean"] == pytest.approx(0.5 / 3.0)  # 0.4, 0, 0.1
+    assert got["env"]["mean"] == pytest.approx(1.0) and got["env"]["n"] == 2
+    assert np.isnan(constant_baseline([], [])["pitch"]["mean"])
+
+
+def test_constant_env_is_scale_invariant_and_zero_for_one_shape():
+    lobe = np.zeros((4, 8))
+    lobe[1, 3:5] = 1.0
+    assert constant_env_errors([lobe, 2.0 * lobe, 0.5 * lobe]) == pytest.approx([0.0, 0.0, 0.0], abs=1e-12)
+    other = np.zeros((4, 8))
+    other[2, 2:6] = 1.0
+    errors = constant_env_errors([lobe, other])
+    assert len(errors) == 2 and min(errors) > 0
+
+
+def test_perfect_results_beat_the_constant_guess(synth_set, tmp_path):
+    """The table's constant column is scored on the same objects: ground truth (0 everywhere) beats it."""
+    results_from_synth(synth_set, tmp_path)
+    report = evaluate(tmp_path, synth_set, progress=False)
+    const = report.summary()["constant"]
+    assert const["alpha"]["mean"] > 0 and const["rho"]["mean"] > 0 and const["env"]["mean"] > 0
+    assert "Best constant (same objects)" in markdown_table(report)
