@@ -86,6 +86,10 @@ class LossConfig:
     random pitch over the input's background, must give back its own radius, height and pose, pitch included
     (step.shape_cycle_term). The pitch of that render is known exactly, so f_S learns to read pitch from images
     drawn the way the data is."""
+    light_cycle_weight: float = 0.0
+    """Weight of the lighting cycle (radar's addition; 0 = off, the paper): the prediction, re-rendered whole at
+    its own pose under another object's predicted lighting and material, must give back that environment map,
+    shininess and specular albedo (f_L) and its own albedo (f_A) (step.light_cycle_term)."""
     sad_patch: int = 64
     """Side of the albedo patches shown to the discriminator (a power of two >= 8)."""
     sad_patches_per_image: int = 4
@@ -138,8 +142,9 @@ class RunConfig:
             raise ConfigError(f"loss.sad_patch must be a power of two in [8, texture size], got {p}")
         if self.loss.mouth_weight < 0 or self.loss.mouth_sigma_px <= 0:
             raise ConfigError("loss.mouth_weight must be >= 0 and loss.mouth_sigma_px > 0")
-        if self.loss.cycle_weight < 0:
-            raise ConfigError(f"loss.cycle_weight must be >= 0, got {self.loss.cycle_weight}")
+        for name in ("cycle_weight", "light_cycle_weight"):
+            if getattr(self.loss, name) < 0:
+                raise ConfigError(f"loss.{name} must be >= 0, got {getattr(self.loss, name)}")
         if not 0 < self.loss.sad_group_fraction <= 0.5:
             raise ConfigError(f"loss.sad_group_fraction must lie in (0, 0.5], got {self.loss.sad_group_fraction}")
         if self.train.batch_size < 1 or self.train.iterations < 0 or self.train.keep_checkpoints < 1:

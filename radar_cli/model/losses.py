@@ -177,6 +177,26 @@ def geometry_l1(pred: tuple[torch.Tensor, ...], target: tuple[torch.Tensor, ...]
     }
 
 
+def material_l1(pred: tuple[torch.Tensor, ...], target: tuple[torch.Tensor, ...],
+                ranges: dict[str, tuple[float, float]]) -> dict[str, torch.Tensor]:
+    """L1 of an albedo, lighting and material against a target; env, alpha and rho mapped to [0, 1] by their range.
+
+    Args:
+        pred, target: (albedo B x 3 x Ht x Wt linear, env B x He x We, alpha B, rho B).
+        ranges: (lo, hi) for "env", "alpha", "rho".
+
+    Returns:
+        Dict of scalar terms: albedo, env, alpha, rho.
+    """
+    (albedo, env, alpha, rho), (t_albedo, t_env, t_alpha, t_rho) = pred, target
+    return {
+        "albedo": (albedo - t_albedo).abs().mean(),
+        "env": (_unit(env, *ranges["env"]) - _unit(t_env, *ranges["env"])).abs().mean(),
+        "alpha": (_unit(alpha, *ranges["alpha"]) - _unit(t_alpha, *ranges["alpha"])).abs().mean(),
+        "rho": (_unit(rho, *ranges["rho"]) - _unit(t_rho, *ranges["rho"])).abs().mean(),
+    }
+
+
 def supervised_loss(pred: Decomposition, target: Decomposition, ranges: dict[str, tuple[float, float]]) -> dict:
     """The supervised baseline of Table 2: L1 of every output against ground truth, each mapped to [0, 1] by
     its range so the terms weigh alike.
@@ -190,10 +210,6 @@ def supervised_loss(pred: Decomposition, target: Decomposition, ranges: dict[str
     """
     geometry = geometry_l1((pred.radius, pred.height, pred.pose), (target.radius, target.height, target.pose),
                            ranges)
-    return {
-        **geometry,
-        "albedo": (pred.albedo - target.albedo).abs().mean(),
-        "env": (_unit(pred.env, *ranges["env"]) - _unit(target.env, *ranges["env"])).abs().mean(),
-        "alpha": (_unit(pred.alpha, *ranges["alpha"]) - _unit(target.alpha, *ranges["alpha"])).abs().mean(),
-        "rho": (_unit(pred.rho, *ranges["rho"]) - _unit(target.rho, *ranges["rho"])).abs().mean(),
-    }
+    material = material_l1((pred.albedo, pred.env, pred.alpha, pred.rho),
+                           (target.albedo, target.env, target.alpha, target.rho), ranges)
+    return {**geometry, **material}

@@ -13,6 +13,7 @@ from torch import nn
 from radar_cli.model import losses as L
 from radar_cli.model.config import RunConfig
 from radar_cli.model.outputs import Decomposition
+from radar_cli.model.radar import RadarModel
 from radar_cli.render.lighting import compose, tone_map
 from radar_cli.render.mouth import coverage, coverage_above, mouth_margin
 from radar_cli.render.raycast import Hits, cast_rays
@@ -130,8 +131,29 @@ def shape_cycle_term(shape_net: nn.Module, pred: Decomposition, batch: Batch, co
     return sum(terms.values())
 
 
+def relit(pred: Decomposition) -> Decomposition:
+    """Each object of a batch with the next one's lighting and material (env, alpha, rho rolled by one)."""
+    return Decomposition(pred.radius, pred.height, pred.pose, pred.albedo, pred.env.roll(1, 0),
+                         pred.alpha.roll(1, 0), pred.rho.roll(1, 0))
+
+
+def light_cycle_term(model: RadarModel, pred: Decomposition, batch: Batch, config: RunConfig) -> torch.Tensor:
+    """The lighting cycle (radar's addition; loss.light_cycle_weight): redraw each prediction, at its own pose,
+    under another object's predicted lighting and material (relit), unwrap the redraw with the shape it was drawn
+    with, and ask f_L for that environment map, shininess and specular albedo and f_A for the same albedo back
+    (material_l1). The lighting of the redraw is known exactly, so f_L learns to read it, and f_A learns to give
+    one albedo whatever the lighting. f_S is not involved; the redrawn image carries no gradient."""
+    target = relit(pred.detach())
+    image = redraw(target, target.pose, background_colour(batch.image, batch.mask), config)
+    texture, normals = model.unwrap_inputs(target.radius, target.height, target.pose, image)
+    env, alpha, rho = model.light_net(texture, normals)
+    terms = L.material_l1((model.albedo_net(texture), env, alpha, rho),
+                          (target.albedo, target.env, target.alpha, target.rho), geometry_ranges(config))
+    return sum(terms.values())
+
+
 def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig, disc: nn.Module | None,
-                     shape_net: nn.Module | None = None) -> tuple[dict[str, torch.Tensor], Rendered]:
+                     model: RadarModel | None = None) -> tuple[dict[str, torch.Tensor], Rendered]:
     """Every loss term of the model (not of D) and their weighted sum under the key "total".
 
     Args:
@@ -139,10 +161,12 @@ def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig, disc:
         batch: the batch.
         config: the run's configuration (weights, switches).
         disc: the bare SAD discriminator (used with frozen weights), or None when L_SAD is off.
-        shape_net: the model's f_S (bare module), for the shape cycle; needed when loss.cycle_weight > 0.
+        model: the model (bare module, not a DDP wrapper), for the cycles; needed when loss.cycle_weight or
+            loss.light_cycle_weight is > 0.
 
     Returns:
-        (losses, rendered): scalar tensors keyed sil, im, alb, mouth, diff, sad, cycle (those enabled) and total.
+        (losses, rendered): scalar tensors keyed sil, im, alb, mouth, diff, sad, cycle, light_cycle (those
+        enabled) and total.
     """
     lc, render = config.loss, config.model.render
     hits, shading, recon, front = render_prediction(pred, config)
@@ -177,10 +201,13 @@ def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig, disc:
                                       lc.sad_patches_per_image, lc.sad_group_fraction)
         terms["sad"] = L.sad_generator_loss(disc, fake)
         total = total + lc.sad_weight * terms["sad"]
+    if (lc.cycle_weight > 0 or lc.light_cycle_weight > 0) and model is None:
+        raise ValueError("loss.cycle_weight or loss.light_cycle_weight > 0 needs the model")
     if lc.cycle_weight > 0:
-        if shape_net is None:
-            raise ValueError("loss.cycle_weight > 0 needs the model's shape_net")
-        terms["cycle"] = shape_cycle_term(shape_net, pred, batch, config)
+        terms["cycle"] = shape_cycle_term(model.shape_net, pred, batch, config)
         total = total + lc.cycle_weight * terms["cycle"]
+    if lc.light_cycle_weight > 0:
+        terms["light_cycle"] = light_cycle_term(model, pred, batch, config)
+        total = total + lc.light_cycle_weight * terms["light_cycle"]
     terms["total"] = total
     return terms, Rendered(hits, shading, recon, front, real, fake)

@@ -103,7 +103,7 @@ def train_step(state: TrainState, model: torch.nn.Module, disc: torch.nn.Module,
     _finite_or_stop(torch.stack([t.sum() for t in pred.as_tuple()]), "a network output", step, info, run_dir)
     bare_disc = D.unwrap(disc)
     terms, rendered = generator_losses(pred, batch, config, bare_disc if uses_sad(config) else None,
-                                       state.model.shape_net)
+                                       state.model)
     _finite_or_stop(terms["total"], "the loss", step, info, run_dir)
     state.opt_model.zero_grad(set_to_none=True)
     terms["total"].backward()

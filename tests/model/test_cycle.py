@@ -1,4 +1,5 @@
-"""The shape cycle (loss.cycle_weight): the redraw is the synthetic image, and only f_S learns from the term."""
+"""The cycles: the shape cycle (loss.cycle_weight; the redraw is the synthetic image, only f_S learns from it) and
+the lighting cycle (loss.light_cycle_weight; only f_L and f_A learn from it)."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ from radar_cli.model.radar import RadarModel
 from radar_cli.render.lighting import tone_map
 from radar_cli.render.texture import full_from_front
 from radar_cli.synth.render import render_sample
-from radar_cli.train.step import background_colour, generator_losses, redraw
+from radar_cli.train.step import background_colour, generator_losses, light_cycle_term, redraw, relit
 
 from .conftest import box_batch, tiny_config
 
@@ -74,40 +75,102 @@ def test_geometry_l1_reference():
     assert all(v.item() == 0 for v in L.geometry_l1(pred, pred, ranges).values())
 
 
+def _model_and_batch(**loss):
+    torch.manual_seed(0)
+    config = tiny_config(**loss)
+    return config, RadarModel(config.model), box_batch(4)
+
+
+def _networks_with_gradients(model: RadarModel) -> set[str]:
+    return {name for name in ("shape_net", "light_net", "albedo_net")
+            if any(p.grad is not None and p.grad.abs().sum() > 0 for p in getattr(model, name).parameters())}
+
+
 @pytest.fixture
 def setup():
-    torch.manual_seed(0)
-    config = tiny_config(cycle_weight=2.0)
-    model = RadarModel(config.model)
-    return config, model, box_batch(4)
+    return _model_and_batch(cycle_weight=2.0)
 
 
-def test_cycle_trains_only_the_shape_network(setup):
-    config, model, batch = setup
-    terms, _ = generator_losses(model(batch.image), batch, config, None, model.shape_net)
-    cycle = terms["cycle"]
+@pytest.mark.parametrize("weight, key, other, learners", [
+    ("cycle_weight", "cycle", "light_cycle", {"shape_net"}),
+    ("light_cycle_weight", "light_cycle", "cycle", {"light_net", "albedo_net"}),
+])
+def test_each_cycle_trains_only_its_networks_and_is_weighted(weight, key, other, learners):
+    config, model, batch = _model_and_batch(**{weight: 3.0})
+    terms, _ = generator_losses(model(batch.image), batch, config, None, model)
+    assert other not in terms
+    cycle = terms[key]
     assert torch.isfinite(cycle) and cycle.item() > 0
+    rest = sum(v for k, v in terms.items() if k not in (key, "total"))
+    assert torch.allclose(terms["total"], rest + 3.0 * cycle)
     cycle.backward()
-    grads = {name for name in ("shape_net", "light_net", "albedo_net")
-             if any(p.grad is not None and p.grad.abs().sum() > 0 for p in getattr(model, name).parameters())}
-    assert grads == {"shape_net"}
+    assert _networks_with_gradients(model) == learners
+    with pytest.raises(ValueError, match="needs the model"):
+        generator_losses(model(batch.image), batch, config, None)
 
 
-def test_cycle_is_weighted_into_the_total(setup):
+def test_shape_cycle_follows_the_global_rng_and_is_off_by_default(setup):
     config, model, batch = setup
     torch.manual_seed(5)
     pred = model(batch.image)
-    terms, _ = generator_losses(pred, batch, config, None, model.shape_net)
-    rest = sum(v for k, v in terms.items() if k not in ("cycle", "total"))
-    assert torch.allclose(terms["total"], rest + 2.0 * terms["cycle"])
+    terms, _ = generator_losses(pred, batch, config, None, model)
     torch.manual_seed(5)  # the redrawn pitch comes from the global RNG: same seed, same term
-    again, _ = generator_losses(model(batch.image), batch, config, None, model.shape_net)
+    again, _ = generator_losses(model(batch.image), batch, config, None, model)
     assert again["cycle"].item() == terms["cycle"].item()
-    with pytest.raises(ValueError, match="shape_net"):
-        generator_losses(pred, batch, config, None)
-    assert "cycle" not in generator_losses(pred, batch, tiny_config(), None, model.shape_net)[0]
+    off, _ = generator_losses(pred, batch, tiny_config(), None, model)
+    assert "cycle" not in off and "light_cycle" not in off
 
 
 def test_negative_cycle_weight_is_rejected():
     with pytest.raises(ConfigError, match="cycle_weight"):
         tiny_config(cycle_weight=-1.0)
+
+
+def test_material_l1_reference():
+    ranges = {"env": (0.0, 1.0), "alpha": (1.0, 196.0), "rho": (0.0, 2.0)}
+    target = (torch.full((1, 3, 2, 2), 0.5), torch.zeros(1, 2, 3), torch.tensor([40.0]), torch.tensor([0.5]))
+    pred = (torch.full((1, 3, 2, 2), 0.7), torch.full((1, 2, 3), 0.25), torch.tensor([79.0]), torch.tensor([1.5]))
+    got = L.material_l1(pred, target, ranges)
+    assert got["albedo"].item() == pytest.approx(0.2)
+    assert got["env"].item() == pytest.approx(0.25)
+    assert got["alpha"].item() == pytest.approx(39.0 / 195.0)
+    assert got["rho"].item() == pytest.approx(0.5)
+    assert all(v.item() == 0 for v in L.material_l1(pred, pred, ranges).values())
+
+
+def test_relit_takes_the_next_objects_lighting():
+    torch.manual_seed(1)
+    pred = RadarModel(tiny_config().model)(box_batch(3).image).detach()
+    got = relit(pred)
+    for kept in ("radius", "height", "pose", "albedo"):
+        assert torch.equal(getattr(got, kept), getattr(pred, kept))
+    for moved in ("env", "alpha", "rho"):
+        mine, theirs = getattr(got, moved), getattr(pred, moved)
+        assert torch.equal(mine[0], theirs[2]) and torch.equal(mine[1], theirs[0]) and torch.equal(mine[2], theirs[1])
+
+
+@pytest.fixture
+def light_setup():
+    return _model_and_batch(light_cycle_weight=3.0)
+
+
+def test_light_cycle_is_learnable(light_setup):
+    """A few Adam steps on the term alone lower it: f_L and f_A can read a redraw's lighting and albedo."""
+    config, model, batch = light_setup
+    with torch.no_grad():
+        target = model(batch.image)  # what is redrawn stays fixed, as it would over a short stretch of training
+    params = list(model.light_net.parameters()) + list(model.albedo_net.parameters())
+    opt = torch.optim.Adam(params, lr=2e-3)
+    values = []
+    for _ in range(12):
+        opt.zero_grad()
+        loss = light_cycle_term(model, target, batch, config)
+        loss.backward()
+        opt.step()
+        values.append(loss.item())
+    assert values[-1] < 0.8 * values[0]
+
+
+def test_negative_light_cycle_weight_is_rejected():
+    with pytest.raises(ConfigError, match="light_cycle_weight"):
+        tiny_config(light_cycle_weight=-0.5)

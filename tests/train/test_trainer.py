@@ -89,8 +89,8 @@ def test_nan_stops_with_step_and_keeps_last_good_checkpoint(vases32, tmp_path, m
     real = trainer.generator_losses
     calls = {"n": 0}
 
-    def poisoned(pred, batch, config, disc, shape_net=None):
-        terms, rendered = real(pred, batch, config, disc, shape_net)
+    def poisoned(pred, batch, config, disc, model=None):
+        terms, rendered = real(pred, batch, config, disc, model)
         calls["n"] += 1
         if calls["n"] == 3:  # step index 2
             terms["total"] = terms["total"] * float("nan")
