@@ -88,8 +88,8 @@ class LossConfig:
     drawn the way the data is."""
     light_cycle_weight: float = 0.0
     """Weight of the lighting cycle (radar's addition; 0 = off, the paper): the prediction, re-rendered whole at
-    its own pose under another object's predicted lighting and material, must give back that environment map,
-    shininess and specular albedo (f_L) and its own albedo (f_A) (step.light_cycle_term)."""
+    its own pose under another object's predicted environment map and specular albedo and a random shininess,
+    must give back that lighting and material (f_L) and its own albedo (f_A) (step.light_cycle_term)."""
     sad_patch: int = 64
     """Side of the albedo patches shown to the discriminator (a power of two >= 8)."""
     sad_patches_per_image: int = 4

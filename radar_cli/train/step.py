@@ -131,19 +131,27 @@ def shape_cycle_term(shape_net: nn.Module, pred: Decomposition, batch: Batch, co
     return sum(terms.values())
 
 
-def relit(pred: Decomposition) -> Decomposition:
-    """Each object of a batch with the next one's lighting and material (env, alpha, rho rolled by one)."""
-    return Decomposition(pred.radius, pred.height, pred.pose, pred.albedo, pred.env.roll(1, 0),
-                         pred.alpha.roll(1, 0), pred.rho.roll(1, 0))
+def relit(pred: Decomposition, alpha: torch.Tensor) -> Decomposition:
+    """Each object of a batch with the next one's environment map and specular albedo (rolled by one) and the
+    given shininess (B)."""
+    return Decomposition(pred.radius, pred.height, pred.pose, pred.albedo, pred.env.roll(1, 0), alpha,
+                         pred.rho.roll(1, 0))
 
 
 def light_cycle_term(model: RadarModel, pred: Decomposition, batch: Batch, config: RunConfig) -> torch.Tensor:
     """The lighting cycle (radar's addition; loss.light_cycle_weight): redraw each prediction, at its own pose,
-    under another object's predicted lighting and material (relit), unwrap the redraw with the shape it was drawn
-    with, and ask f_L for that environment map, shininess and specular albedo and f_A for the same albedo back
-    (material_l1). The lighting of the redraw is known exactly, so f_L learns to read it, and f_A learns to give
-    one albedo whatever the lighting. f_S is not involved; the redrawn image carries no gradient."""
-    target = relit(pred.detach())
+    under another object's predicted environment map and specular albedo and a shininess drawn uniformly from the
+    model's range (the global RNG), unwrap the redraw with the shape it was drawn with, and ask f_L for that
+    lighting and material and f_A for the same albedo back (material_l1). The lighting of the redraw is known
+    exactly, so f_L learns to read it, and f_A learns to give one albedo whatever the lighting. f_S is not
+    involved; the redrawn image carries no gradient.
+
+    The shininess is drawn, not taken from another prediction: asked to give back predicted values it cannot read
+    from a 64 px image, f_L answered one constant for every object, the term was then met trivially, and the
+    other losses drove that constant to the range's top (measured: every prediction 195-196 after 1,000 steps)."""
+    detached = pred.detach()
+    lo, hi = config.model.shininess_range
+    target = relit(detached, lo + (hi - lo) * torch.rand(detached.alpha.shape[0]).to(detached.alpha))
     image = redraw(target, target.pose, background_colour(batch.image, batch.mask), config)
     texture, normals = model.unwrap_inputs(target.radius, target.height, target.pose, image)
     env, alpha, rho = model.light_net(texture, normals)

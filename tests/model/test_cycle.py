@@ -141,10 +141,12 @@ def test_material_l1_reference():
 def test_relit_takes_the_next_objects_lighting():
     torch.manual_seed(1)
     pred = RadarModel(tiny_config().model)(box_batch(3).image).detach()
-    got = relit(pred)
+    alpha = torch.tensor([5.0, 50.0, 150.0])
+    got = relit(pred, alpha)
+    assert torch.equal(got.alpha, alpha)
     for kept in ("radius", "height", "pose", "albedo"):
         assert torch.equal(getattr(got, kept), getattr(pred, kept))
-    for moved in ("env", "alpha", "rho"):
+    for moved in ("env", "rho"):
         mine, theirs = getattr(got, moved), getattr(pred, moved)
         assert torch.equal(mine[0], theirs[2]) and torch.equal(mine[1], theirs[0]) and torch.equal(mine[2], theirs[1])
 
@@ -162,13 +164,14 @@ def test_light_cycle_is_learnable(light_setup):
     params = list(model.light_net.parameters()) + list(model.albedo_net.parameters())
     opt = torch.optim.Adam(params, lr=2e-3)
     values = []
-    for _ in range(12):
+    for _ in range(20):
         opt.zero_grad()
+        torch.manual_seed(3)  # the same random shininess every step
         loss = light_cycle_term(model, target, batch, config)
         loss.backward()
         opt.step()
         values.append(loss.item())
-    assert values[-1] < 0.8 * values[0]
+    assert values[-1] < 0.7 * values[0]  # measured: 0.59 -> 0.28
 
 
 def test_negative_light_cycle_weight_is_rejected():
