@@ -42,7 +42,7 @@ def test_silhouette_fit_recovers_shape_and_pose(random_sor):
         opt.zero_grad()
         loss.backward()
         opt.step()
-    r, h, p = params()
-    fitted = cast_rays(r.detach(), h.detach(), p.detach(), SIZE).mask
+    r, h, p = (t.detach() for t in params())
+    fitted = cast_rays(r, h, p, SIZE).mask
     assert iou(fitted, target.bool()) >= 0.98
     assert abs(float(p[0, 0]) - float(pose[0, 0])) <= 1.0, (p, pose)
