@@ -74,7 +74,6 @@ def to_uint8(image: np.ndarray) -> np.ndarray:
 
 
 PNG_LEVEL = 6  # zlib level of PNG writes (Pillow's default)
-FAST_PNG_LEVEL = 1  # for bulk writers (radar synth): 2.5x faster to encode, files ~25% larger
 
 
 def write_image(path: str | Path, image: np.ndarray, png_level: int = PNG_LEVEL) -> None:
@@ -90,6 +89,27 @@ def encode_image(image: np.ndarray, fmt: str = "PNG", png_level: int = PNG_LEVEL
     buffer = io.BytesIO()
     Image.fromarray(image).save(buffer, format=fmt, **({"compress_level": png_level} if fmt == "PNG" else {}))
     return buffer.getvalue()
+
+
+def encode_png_fast(image: np.ndarray) -> bytes:
+    """PNG bytes for bulk writers (radar synth): zlib level 1 and the Sub filter on every row, through OpenCV.
+
+    Pillow's level-6 PNGs are 2.5x slower to encode than level 1 (files ~25% smaller), and Pillow tries every row
+    filter where one does: on synthetic samples at 256 px this writes a sample's 7 PNGs in 11.3 ms instead of
+    18.4 ms at level 1 through Pillow, files 3% larger, pixels identical. Float arrays are taken as [0, 1], uint8
+    as is; H x W or H x W x 3 (RGB).
+    """
+    import cv2  # here, not at the top: `radar fetch` and the other light commands never load OpenCV
+
+    if image.dtype != np.uint8:
+        image = to_uint8(image)
+    if image.ndim == 3:
+        image = np.ascontiguousarray(image[..., ::-1])  # OpenCV writes BGR
+    ok, buffer = cv2.imencode(".png", image, [cv2.IMWRITE_PNG_COMPRESSION, 1,
+                                              cv2.IMWRITE_PNG_FILTER, cv2.IMWRITE_PNG_FILTER_SUB])
+    if not ok:
+        raise ValueError(f"OpenCV could not encode a {image.shape} {image.dtype} image as PNG")
+    return buffer.tobytes()
 
 
 def _format_for(path: Path) -> str:

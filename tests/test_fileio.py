@@ -1,5 +1,6 @@
 """Atomic writes and safe image reading."""
 
+import io
 import os
 
 import numpy as np
@@ -66,3 +67,16 @@ def test_exif_orientation_honoured(tmp_path):
     exif[0x0112] = 6  # rotate 90 deg clockwise on display
     im.save(path, exif=exif.tobytes())
     assert fileio.read_image(path).shape == (8, 4, 3)
+
+
+@pytest.mark.parametrize("shape, dtype", [((9, 14, 3), np.float32), ((9, 14), np.float32), ((9, 14, 3), np.uint8),
+                                          ((9, 14), np.uint8)])
+def test_fast_png_decodes_to_the_same_pixels(shape, dtype):
+    """radar synth's encoder (OpenCV, level 1, Sub filter): the same pixels, in RGB order, as Pillow's PNG."""
+    rng = np.random.default_rng(0)
+    image = rng.random(shape).astype(np.float32) if dtype == np.float32 else rng.integers(0, 256, shape, np.uint8)
+    fast = fileio.encode_png_fast(image)
+    assert fast[:8] == b"\x89PNG\r\n\x1a\n"
+    got = np.array(Image.open(io.BytesIO(fast)))
+    want = np.array(Image.open(io.BytesIO(fileio.encode_image(image, "PNG"))))
+    assert got.shape == shape and np.array_equal(got, want)

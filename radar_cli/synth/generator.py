@@ -27,7 +27,7 @@ from radar_cli.allocator import keep_freed_memory
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig, to_dict
 from radar_cli.dataset import IMAGE_FILE, MASK_FILE, SPLITS, sample_images, sample_ref
 from radar_cli.errors import ConfigError, InputError, RadarError
-from radar_cli.fileio import FAST_PNG_LEVEL, encode_image, encode_json, encode_npy, write_json, write_text
+from radar_cli.fileio import encode_json, encode_npy, encode_png_fast, write_json, write_text
 from radar_cli.synth import layout
 from radar_cli.synth.lighting import bake_env, sample_lobes
 from radar_cli.synth.render import env_preview, render_sample
@@ -167,7 +167,7 @@ def write_sample_folder(root: Path, split: str, sid: str, files: dict, params: d
         if name.endswith(".npy"):
             data = encode_npy(arr)
         else:
-            data = encode_image(arr.astype(np.uint8) * 255 if arr.dtype == bool else arr, "PNG", FAST_PNG_LEVEL)
+            data = encode_png_fast(arr.astype(np.uint8) * 255 if arr.dtype == bool else arr)
         (tmp / name).write_bytes(data)
     (tmp / layout.PARAMS_FILE).write_bytes(encode_json(params))
     if final.exists():  # an unfinished folder from an older run
