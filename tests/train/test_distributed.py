@@ -1,5 +1,5 @@
 """DistributedDataParallel: 2 CPU processes on gloo under torchrun end a few steps with identical weights (every
-loss term on, the shape cycle included: its second pass through f_S runs outside DDP's forward)."""
+loss term on, both cycles included: their second passes through f_S, f_L and f_A run outside DDP's forward)."""
 
 from __future__ import annotations
 
@@ -29,7 +29,8 @@ SCRIPT = textwrap.dedent('''
 
     torch.set_num_threads(1)
     config = tiny_config(iterations=3)
-    config = dataclasses.replace(config, loss=dataclasses.replace(config.loss, cycle_weight=1.0))
+    cycles = dataclasses.replace(config.loss, cycle_weight=1.0, light_cycle_weight=1.0)
+    config = dataclasses.replace(config, loss=cycles)
     summary = train(config, sys.argv[1], sys.argv[2], progress=False)
     rank = os.environ["RANK"]
     state = {k: v.contiguous() for k, v in summary.state.model.state_dict().items()}
