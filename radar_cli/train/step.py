@@ -58,7 +58,7 @@ class Rendered:
     sad_fake: torch.Tensor | None
 
 
-def geometry_ranges(config: RunConfig) -> dict[str, tuple[float, float]]:
+def output_ranges(config: RunConfig) -> dict[str, tuple[float, float]]:
     """The (lo, hi) range of every output, for the supervised loss."""
     g, m = config.model.geometry, config.model
     return {"radius": g.radius_range, "height": g.height_range, "pitch": g.pitch_range, "roll": g.roll_range,
@@ -127,12 +127,12 @@ def shape_cycle_term(shape_net: nn.Module, pred: Decomposition, batch: Batch, co
     pose = target.pose.clone()
     pose[:, 0] = lo + (hi - lo) * torch.rand(pose.shape[0]).to(pose)
     image = redraw(target, pose, background_colour(batch.image, batch.mask), config)
-    terms = L.geometry_l1(shape_net(image), (target.radius, target.height, pose), geometry_ranges(config))
+    terms = L.geometry_l1(shape_net(image), (target.radius, target.height, pose), output_ranges(config))
     return sum(terms.values())
 
 
 def relit(pred: Decomposition, alpha: torch.Tensor) -> Decomposition:
-    """Each object of a batch with the next one's environment map and specular albedo (rolled by one) and the
+    """Each object of a batch with the previous one's environment map and specular albedo (rolled by one) and the
     given shininess (B)."""
     return Decomposition(pred.radius, pred.height, pred.pose, pred.albedo, pred.env.roll(1, 0), alpha,
                          pred.rho.roll(1, 0))
@@ -156,7 +156,7 @@ def light_cycle_term(model: RadarModel, pred: Decomposition, batch: Batch, confi
     texture, normals = model.unwrap_inputs(target.radius, target.height, target.pose, image)
     env, alpha, rho = model.light_net(texture, normals)
     terms = L.material_l1((model.albedo_net(texture), env, alpha, rho),
-                          (target.albedo, target.env, target.alpha, target.rho), geometry_ranges(config))
+                          (target.albedo, target.env, target.alpha, target.rho), output_ranges(config))
     return sum(terms.values())
 
 
@@ -183,7 +183,7 @@ def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig, disc:
             from radar_cli.errors import InputError
 
             raise InputError("loss.supervised needs ground truth (params.json etc.) in every training sample")
-        terms = L.supervised_loss(pred, batch.target, geometry_ranges(config))
+        terms = L.supervised_loss(pred, batch.target, output_ranges(config))
         terms = {f"sup_{k}": v for k, v in terms.items()}
         terms["total"] = sum(terms.values())
         return terms, Rendered(hits, shading, recon, front, None, None)

@@ -138,7 +138,7 @@ def test_material_l1_reference():
     assert all(v.item() == 0 for v in L.material_l1(pred, pred, ranges).values())
 
 
-def test_relit_takes_the_next_objects_lighting():
+def test_relit_takes_the_previous_objects_lighting():
     torch.manual_seed(1)
     pred = RadarModel(tiny_config().model)(box_batch(3).image).detach()
     alpha = torch.tensor([5.0, 50.0, 150.0])

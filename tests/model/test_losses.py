@@ -134,13 +134,13 @@ def test_mean_colour_render_matches_compose(setup):
 
 def test_supervised_loss_zero_on_truth(setup):
     config, model, _, batch = setup
-    from radar_cli.train.step import geometry_ranges
+    from radar_cli.train.step import output_ranges
 
     d = model(batch.image).detach()
-    terms = L.supervised_loss(d, d, geometry_ranges(config))
+    terms = L.supervised_loss(d, d, output_ranges(config))
     assert all(v.item() == 0 for v in terms.values())
     d2 = model(batch.image)
     other = type(d)(*(t.detach() * 0.9 for t in d.as_tuple()))
-    total = sum(L.supervised_loss(d2, other, geometry_ranges(config)).values())
+    total = sum(L.supervised_loss(d2, other, output_ranges(config)).values())
     total.backward()
     assert _grads(model.shape_net) and _grads(model.light_net) and _grads(model.albedo_net)
