@@ -128,11 +128,22 @@ def render_synthetic(
     Returns:
         (image B x 3 x H x W tone-mapped, the hits (soft silhouette on the object only), the shading).
     """
-    shading = shade(radius, height, pose, albedo_full, env, alpha, rho, render, camera, span=FULL_SPAN)
-    hits = cast_rays(radius, height, pose, size, camera, render.sil_sigma_px, soft_outside=False)
-    image, hard = render_texture(hits, shading.texture, front_only=False, inside_dim=render.inside_dim,
-                                 background=background)
+    image, hard, hits, shading = _draw_whole(radius, height, pose, albedo_full, env, alpha, rho, size, render,
+                                             camera, background, soft_outside=False)
     return image * hard + background * (1 - hard), hits, shading
+
+
+def _draw_whole(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, albedo_full: torch.Tensor,
+                env: torch.Tensor, alpha: torch.Tensor, rho: torch.Tensor, size: int, render: RenderConfig,
+                camera: CameraConfig, background: float | torch.Tensor,
+                soft_outside: bool) -> tuple[torch.Tensor, torch.Tensor, Hits, Shading]:
+    """Shade a 360 deg albedo, cast the rays (cast_rays' soft_outside) and draw the whole object, inside dimmed:
+    (image B x 3 x H x W over `background` by the soft silhouette, that coverage B x 1 x H x W, hits, shading)."""
+    shading = shade(radius, height, pose, albedo_full, env, alpha, rho, render, camera, span=FULL_SPAN)
+    hits = cast_rays(radius, height, pose, size, camera, render.sil_sigma_px, soft_outside=soft_outside)
+    image, coverage = render_texture(hits, shading.texture, front_only=False, inside_dim=render.inside_dim,
+                                     background=background)
+    return image, coverage, hits, shading
 
 
 def rotate_full_map(texture: torch.Tensor, yaw_deg: float) -> torch.Tensor:
@@ -176,11 +187,8 @@ def render_view(
         (image B x 3 x H x W tone-mapped over `background`, mask B x 1 x H x W float coverage).
     """
     check_shape(albedo_full, "B 3 Ht Wt", "albedo_full", {"B": radius.shape[0]})
-    albedo = rotate_full_map(albedo_full, yaw_deg)
-    shading = shade(radius, height, pose, albedo, env, alpha, rho, render, camera, span=FULL_SPAN)
-    hits = cast_rays(radius, height, pose, size, camera, render.sil_sigma_px)
-    image, _ = render_texture(hits, shading.texture, front_only=False, inside_dim=render.inside_dim,
-                              background=background)
+    image, _, hits, _ = _draw_whole(radius, height, pose, rotate_full_map(albedo_full, yaw_deg), env, alpha, rho,
+                                    size, render, camera, background, soft_outside=True)
     return image, hits.sil[:, None]
 
 

@@ -118,15 +118,17 @@ def redraw(pred: Decomposition, pose: torch.Tensor, background: torch.Tensor, co
     return (image.clamp(0.0, 1.0) * 255).round() / 255
 
 
-def shape_cycle_term(shape_net: nn.Module, pred: Decomposition, batch: Batch, config: RunConfig) -> torch.Tensor:
+def shape_cycle_term(shape_net: nn.Module, pred: Decomposition, background: torch.Tensor,
+                     config: RunConfig) -> torch.Tensor:
     """The shape cycle (radar's addition; loss.cycle_weight): redraw the prediction at a pitch drawn uniformly
-    from the model's range (the global RNG, reseeded every step) and ask f_S for its radius, height and pose
-    back (geometry_l1 against what was drawn). Only f_S learns from it; the redrawn image carries no gradient."""
+    from the model's range (the global RNG, reseeded every step) over `background` (B x 3 x 1 x 1, the inputs'
+    background_colour) and ask f_S for its radius, height and pose back (geometry_l1 against what was drawn).
+    Only f_S learns from it; the redrawn image carries no gradient."""
     target = pred.detach()
     lo, hi = config.model.geometry.pitch_range
     pose = target.pose.clone()
     pose[:, 0] = lo + (hi - lo) * torch.rand(pose.shape[0]).to(pose)
-    image = redraw(target, pose, background_colour(batch.image, batch.mask), config)
+    image = redraw(target, pose, background, config)
     terms = L.geometry_l1(shape_net(image), (target.radius, target.height, pose), output_ranges(config))
     return sum(terms.values())
 
@@ -138,13 +140,14 @@ def relit(pred: Decomposition, alpha: torch.Tensor) -> Decomposition:
                          pred.rho.roll(1, 0))
 
 
-def light_cycle_term(model: RadarModel, pred: Decomposition, batch: Batch, config: RunConfig) -> torch.Tensor:
+def light_cycle_term(model: RadarModel, pred: Decomposition, background: torch.Tensor,
+                     config: RunConfig) -> torch.Tensor:
     """The lighting cycle (radar's addition; loss.light_cycle_weight): redraw each prediction, at its own pose,
     under another object's predicted environment map and specular albedo and a shininess drawn uniformly from the
-    model's range (the global RNG), unwrap the redraw with the shape it was drawn with, and ask f_L for that
-    lighting and material and f_A for the same albedo back (material_l1). The lighting of the redraw is known
-    exactly, so f_L learns to read it, and f_A learns to give one albedo whatever the lighting. f_S is not
-    involved; the redrawn image carries no gradient.
+    model's range (the global RNG), over `background` as in the shape cycle; unwrap the redraw with the shape it
+    was drawn with, and ask f_L for that lighting and material and f_A for the same albedo back (material_l1).
+    The lighting of the redraw is known exactly, so f_L learns to read it, and f_A learns to give one albedo
+    whatever the lighting. f_S is not involved; the redrawn image carries no gradient.
 
     The shininess is drawn, not taken from another prediction: asked to give back predicted values it cannot read
     from a 64 px image, f_L answered one constant for every object, the term was then met trivially, and the
@@ -152,7 +155,7 @@ def light_cycle_term(model: RadarModel, pred: Decomposition, batch: Batch, confi
     detached = pred.detach()
     lo, hi = config.model.shininess_range
     target = relit(detached, lo + (hi - lo) * torch.rand(detached.alpha.shape[0]).to(detached.alpha))
-    image = redraw(target, target.pose, background_colour(batch.image, batch.mask), config)
+    image = redraw(target, target.pose, background, config)
     texture, normals = model.unwrap_inputs(target.radius, target.height, target.pose, image)
     env, alpha, rho = model.light_net(texture, normals)
     terms = L.material_l1((model.albedo_net(texture), env, alpha, rho),
@@ -209,13 +212,15 @@ def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig, disc:
                                       lc.sad_patches_per_image, lc.sad_group_fraction)
         terms["sad"] = L.sad_generator_loss(disc, fake)
         total = total + lc.sad_weight * terms["sad"]
-    if (lc.cycle_weight > 0 or lc.light_cycle_weight > 0) and model is None:
-        raise ValueError("loss.cycle_weight or loss.light_cycle_weight > 0 needs the model")
+    if lc.cycle_weight > 0 or lc.light_cycle_weight > 0:
+        if model is None:
+            raise ValueError("loss.cycle_weight or loss.light_cycle_weight > 0 needs the model")
+        background = background_colour(batch.image, batch.mask)
     if lc.cycle_weight > 0:
-        terms["cycle"] = shape_cycle_term(model.shape_net, pred, batch, config)
+        terms["cycle"] = shape_cycle_term(model.shape_net, pred, background, config)
         total = total + lc.cycle_weight * terms["cycle"]
     if lc.light_cycle_weight > 0:
-        terms["light_cycle"] = light_cycle_term(model, pred, batch, config)
+        terms["light_cycle"] = light_cycle_term(model, pred, background, config)
         total = total + lc.light_cycle_weight * terms["light_cycle"]
     terms["total"] = total
     return terms, Rendered(hits, shading, recon, front, real, fake)

@@ -167,7 +167,7 @@ def test_light_cycle_is_learnable(light_setup):
     for _ in range(20):
         opt.zero_grad()
         torch.manual_seed(3)  # the same random shininess every step
-        loss = light_cycle_term(model, target, batch, config)
+        loss = light_cycle_term(model, target, background_colour(batch.image, batch.mask), config)
         loss.backward()
         opt.step()
         values.append(loss.item())
