@@ -23,15 +23,20 @@ from radar_cli.model.config import load_run_config
               help="Start from the weights of this checkpoint or model file (fine-tuning; fresh optimizers).")
 @click.option("--threads", type=click.IntRange(min=1), default=None,
               help="Overrides train.threads (CPU threads; the CPU presets use 1 for shared machines).")
+@click.option("--max-minutes", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Wall-time budget: past it, write a checkpoint and stop (continue with --resume).")
 def train(config_path: str, data_dir: str, run_dir: str, resume: bool, device: str | None, overfit: int | None,
-          iterations: int | None, init: str | None, threads: int | None) -> None:
+          iterations: int | None, init: str | None, threads: int | None, max_minutes: float | None) -> None:
     """Train the de-rendering model (shape, lighting, albedo networks + SAD discriminator)."""
     from radar_cli.train.trainer import train as run_training
 
     summary = run_training(load_run_config(config_path), data_dir, run_dir, resume=resume, device=device,
-                           overfit=overfit, iterations=iterations, init=init, threads=threads)
+                           overfit=overfit, iterations=iterations, init=init, threads=threads,
+                           max_minutes=max_minutes)
     losses = "  ".join(f"{k}={v:.4f}" for k, v in summary.losses.items())
     click.echo(f"trained steps {summary.start}..{summary.end} in {summary.seconds:.1f} s "
                f"({summary.sec_per_step:.3f} s/step)")
     click.echo(f"final losses: {losses}")
     click.echo(f"checkpoint: {summary.checkpoint}")
+    if summary.out_of_time:
+        click.echo(f"stopped by --max-minutes at step {summary.end}; continue with --resume")

@@ -85,6 +85,15 @@ def all_finite(value: torch.Tensor, info: DistInfo) -> bool:
     return bool(ok.item() > 0)
 
 
+def any_rank(flag: bool, info: DistInfo) -> bool:
+    """True if `flag` is true on any rank (so all ranks stop together)."""
+    if not info.enabled:
+        return flag
+    t = torch.tensor([float(flag)])
+    dist.all_reduce(t, op=dist.ReduceOp.MAX)
+    return bool(t.item() > 0)
+
+
 def mean_across(values: dict[str, float], info: DistInfo) -> dict[str, float]:
     """Average scalar metrics over ranks (for logging)."""
     if not info.enabled or not values:

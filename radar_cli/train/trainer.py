@@ -39,6 +39,7 @@ class TrainSummary:
         run_dir: the run folder. start, end: first step run and the step count reached.
         losses: the last step's loss terms. history: every step's terms (this process's batch share).
         checkpoint: the last checkpoint written. seconds: wall time of the loop. sec_per_step: its mean.
+        out_of_time: the run stopped at its wall-time budget (max_minutes) before reaching its iterations.
         state: the trained modules and optimizers.
     """
 
@@ -50,6 +51,7 @@ class TrainSummary:
     checkpoint: Path | None
     seconds: float
     sec_per_step: float
+    out_of_time: bool
     state: TrainState = dataclasses.field(repr=False)
 
 
@@ -143,7 +145,8 @@ def apply_overrides(config: RunConfig, iterations: int | None, overfit: int | No
 
 def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: bool = False,
           device: str | None = None, overfit: int | None = None, iterations: int | None = None,
-          progress: bool = True, init: str | Path | None = None, threads: int | None = None) -> TrainSummary:
+          progress: bool = True, init: str | Path | None = None, threads: int | None = None,
+          max_minutes: float | None = None) -> TrainSummary:
     """Train RADAR on DATA/train and write checkpoints, metrics and images to run_dir.
 
     Args:
@@ -158,6 +161,8 @@ def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: 
         init: start from this checkpoint's weights (fine-tuning); ignored when resuming a run that has
             checkpoints of its own.
         threads: CPU threads (overrides config.train.threads).
+        max_minutes: wall-time budget of the loop: once a step ends past it, a checkpoint is written and the
+            run stops (continue it with resume=True), e.g. inside a batch job's time limit.
 
     Returns:
         TrainSummary.
@@ -173,13 +178,13 @@ def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: 
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
     try:
-        return _run(config, Path(data_dir), run_dir, resume, overfit, info, progress, init)
+        return _run(config, Path(data_dir), run_dir, resume, overfit, info, progress, init, max_minutes)
     finally:
         D.teardown(info)
 
 
 def _run(config: RunConfig, data_dir: Path, run_dir: Path, resume: bool, overfit: int | None,
-         info: D.DistInfo, progress: bool, init: str | Path | None) -> TrainSummary:
+         info: D.DistInfo, progress: bool, init: str | Path | None, max_minutes: float | None) -> TrainSummary:
     t = config.train
     dataset = VaseDataset(data_dir, "train", config.model.render.image_size, limit=overfit)
     if config.loss.supervised:
@@ -193,7 +198,8 @@ def _run(config: RunConfig, data_dir: Path, run_dir: Path, resume: bool, overfit
     sampler = StepBatchSampler(len(dataset), t.batch_size, t.seed, start, t.iterations, info.rank, info.world)
     logger = RunLogger(run_dir, start, t.iterations, enabled=info.is_main, bar=progress)
     history: list[dict[str, float]] = []
-    ckpt, t0, terms = None, time.perf_counter(), {}
+    ckpt, t0, terms, out_of_time = None, time.perf_counter(), {}, False
+    deadline = None if max_minutes is None else t0 + 60.0 * max_minutes
     try:
         for step, items in enumerate(make_loader(dataset, sampler), start=start):
             torch.manual_seed(t.seed * 1_000_003 + step * info.world + info.rank)
@@ -211,14 +217,18 @@ def _run(config: RunConfig, data_dir: Path, run_dir: Path, resume: bool, overfit
             logger.step(step, values)
             if done % t.image_every == 0 or done == t.iterations:
                 logger.grid(done, batch, pred, rendered, config.model.render.gamma)
-            if done % t.checkpoint_every == 0 or done == t.iterations:
+            if deadline is not None and done < t.iterations:
+                out_of_time = D.any_rank(time.perf_counter() >= deadline, info)
+            if done % t.checkpoint_every == 0 or done == t.iterations or out_of_time:
                 if info.is_main:
                     ckpt = save_checkpoint(run_dir, config, state, t.keep_checkpoints)
                 D.barrier(info)
+            if out_of_time:
+                break
     finally:
         logger.close()
     if info.is_main and ckpt is not None and state.step == t.iterations:
         export_weights(ckpt, run_dir / MODEL_FILE)  # what `radar derender --checkpoint` takes
     seconds = time.perf_counter() - t0
     n = max(1, len(history))
-    return TrainSummary(run_dir, start, state.step, terms, history, ckpt, seconds, seconds / n, state)
+    return TrainSummary(run_dir, start, state.step, terms, history, ckpt, seconds, seconds / n, out_of_time, state)

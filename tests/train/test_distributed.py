@@ -31,8 +31,12 @@ SCRIPT = textwrap.dedent('''
     config = tiny_config(iterations=3)
     cycles = dataclasses.replace(config.loss, cycle_weight=1.0, light_cycle_weight=1.0)
     config = dataclasses.replace(config, loss=cycles)
-    summary = train(config, sys.argv[1], sys.argv[2], progress=False)
     rank = os.environ["RANK"]
+    budget = None  # the ranks of a real run share --max-minutes; here rank 1's clock runs out first
+    if sys.argv[4] == "rank1-out-of-time":
+        budget = 1e-9 if rank == "1" else 60.0
+    summary = train(config, sys.argv[1], sys.argv[2], progress=False, max_minutes=budget)
+    assert summary.end == (3 if budget is None else 1), summary.end
     state = {k: v.contiguous() for k, v in summary.state.model.state_dict().items()}
     state.update({"disc." + k: v.contiguous() for k, v in summary.state.disc.state_dict().items()})
     save_file(state, os.path.join(sys.argv[2], f"rank{rank}.safetensors"))
@@ -49,15 +53,19 @@ def test_sampler_splits_the_global_batch_across_ranks():
     assert sorted(epoch0) == list(range(10))  # every sample once per epoch
 
 
-def test_ddp_two_gloo_processes_end_with_identical_weights(vases32, tmp_path):
-    script = tmp_path / "ddp_train.py"
+def _torchrun(vases32, run: Path, mode: str) -> None:
+    script = run.parent / "ddp_train.py"
     script.write_text(SCRIPT)
-    run = tmp_path / "run"
     env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=str(REPO))
     cmd = [sys.executable, "-m", "torch.distributed.run", "--standalone", "--nproc_per_node=2", str(script),
-           str(vases32), str(run), str(Path(__file__).parent)]
+           str(vases32), str(run), str(Path(__file__).parent), mode]
     done = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-3000:]
+
+
+def test_ddp_two_gloo_processes_end_with_identical_weights(vases32, tmp_path):
+    run = tmp_path / "run"
+    _torchrun(vases32, run, "full")
     a, b = load_file(str(run / "rank0.safetensors")), load_file(str(run / "rank1.safetensors"))
     assert a.keys() == b.keys()
     for k in a:
@@ -65,3 +73,9 @@ def test_ddp_two_gloo_processes_end_with_identical_weights(vases32, tmp_path):
     init = build_state(tiny_config(), torch.device("cpu")).model.state_dict()
     assert any(not torch.equal(init[k], a["" + k]) for k in init)  # the ranks trained, in step
     assert len(list((run / "checkpoints").iterdir())) == 2  # only rank 0 writes checkpoints
+
+
+def test_ddp_ranks_stop_together_when_one_runs_out_of_time(vases32, tmp_path):
+    run = tmp_path / "run"
+    _torchrun(vases32, run, "rank1-out-of-time")  # the script asserts both end at step 1
+    assert [p.name for p in (run / "checkpoints").iterdir()] == ["step_0000001.safetensors"]

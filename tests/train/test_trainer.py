@@ -65,6 +65,19 @@ def test_resume_continues_exactly(vases32, tmp_path, monkeypatch, decay):
     assert steps == list(range(6))
 
 
+def test_time_budget_checkpoints_and_stops_then_resume_finishes(vases32, tmp_path):
+    config = tiny_config(iterations=4, checkpoint_every=100)
+    full = train(config, vases32, tmp_path / "a", progress=False)
+    assert not full.out_of_time
+    cut = train(config, vases32, tmp_path / "b", progress=False, max_minutes=1e-9)  # spent after the first step
+    assert cut.out_of_time and (cut.start, cut.end) == (0, 1)
+    assert [p.name for p in list_checkpoints(tmp_path / "b")] == ["step_0000001.safetensors"]
+    assert not (tmp_path / "b" / "model.safetensors").exists()  # weights are exported only at the last step
+    resumed = train(config, vases32, tmp_path / "b", resume=True, progress=False, max_minutes=60)
+    assert not resumed.out_of_time and (resumed.start, resumed.end) == (1, 4)
+    assert [h["total"] for h in resumed.history] == pytest.approx([h["total"] for h in full.history[1:]], rel=1e-5)
+
+
 def test_init_fine_tunes_from_another_run_and_resumes_its_own(vases32, tmp_path):
     first = train(tiny_config(iterations=2, checkpoint_every=2), vases32, tmp_path / "a", progress=False)
     tuned = train(tiny_config(iterations=2, checkpoint_every=1), vases32, tmp_path / "b", progress=False,
