@@ -19,7 +19,8 @@ def bench_synth(size: int, n: int, workers: int, shading_size: int = 0, seed: in
     """Generate n test-split samples with `workers` processes and time them.
 
     Returns:
-        JSON-ready dict: samples_per_sec (wall, pool start-up included), sec_per_sample for make and write
+        JSON-ready dict: samples_per_sec (wall, pool start-up included), startup_sec (until the first sample
+        came back), steady_samples_per_sec (after it: a long run's rate), sec_per_sample for make and write
         (single process, one thread, the median of STAGE_SAMPLES samples), and the settings.
     """
     cfg = SynthConfig(size=size, seed=seed, shading_size=shading_size)
@@ -32,6 +33,8 @@ def bench_synth(size: int, n: int, workers: int, shading_size: int = 0, seed: in
         "workers": workers,
         "shading_grid": cfg.grids()["shading"],
         "samples_per_sec": round(summary.rate, 2),
+        "startup_sec": round(summary.first_seconds, 2),
+        "steady_samples_per_sec": round(summary.steady_rate, 2),
         "failed": len(summary.failed),
         "sec_per_sample_make": round(make_s, 4),
         "sec_per_sample_write": round(write_s, 4),

@@ -94,11 +94,21 @@ class SynthSummary:
     skipped: int = 0
     failed: list[tuple[str, str, str]] = field(default_factory=list)  # (split, id, problem)
     seconds: float = 0.0
+    first_seconds: float = 0.0  # wall time until the first sample came back: the pool's start-up + one sample
+    workers: int = 1
 
     @property
     def rate(self) -> float:
         """Samples written per second of wall time."""
         return self.written / self.seconds if self.seconds > 0 else 0.0
+
+    @property
+    def steady_rate(self) -> float:
+        """Samples per second once every worker is running: the samples after each worker's first over the time
+        after the first came back (a long run's rate; start-up weighs on `rate` in short ones)."""
+        later = self.written + len(self.failed) - self.workers
+        span = self.seconds - self.first_seconds
+        return later / span if later > 0 and span > 0 else self.rate
 
 
 def sample_id(index: int) -> str:
@@ -242,7 +252,7 @@ def generate(out: str | Path, splits: dict[str, int], cfg: SynthConfig = SynthCo
     root.mkdir(parents=True, exist_ok=True)
     _check_settings(root, cfg)
     _clean_partial(root)
-    summary = SynthSummary()
+    summary = SynthSummary(workers=max(1, workers))
     jobs = []
     for split, n in splits.items():
         for index in range(n):
@@ -253,6 +263,8 @@ def generate(out: str | Path, splits: dict[str, int], cfg: SynthConfig = SynthCo
     start = time.perf_counter()
     bar = tqdm(total=len(jobs), desc="synth", unit="vase", disable=not progress)
     for split, sid, problem in _run(jobs, workers):
+        if not summary.first_seconds:
+            summary.first_seconds = time.perf_counter() - start
         if problem:
             summary.failed.append((split, sid, problem))
             tqdm.write(f"{root / split / sid}: {problem}")

@@ -56,4 +56,5 @@ def test_bench_synth_prints_throughput_and_stage_split():
     assert result.exit_code == 0, result.output
     out = json.loads(result.output)
     assert out["samples"] == 3 and out["failed"] == 0 and out["samples_per_sec"] > 0
+    assert 0 < out["startup_sec"] and out["steady_samples_per_sec"] > 0
     assert out["sec_per_sample_make"] > 0 and out["sec_per_sample_write"] > 0

@@ -15,7 +15,7 @@ from radar_cli.dataset import IMAGE_FILE, list_samples, read_sample
 from radar_cli.errors import ConfigError
 from radar_cli.fileio import read_image
 from radar_cli.synth import layout
-from radar_cli.synth.generator import SynthConfig, generate, make_sample
+from radar_cli.synth.generator import SynthConfig, SynthSummary, generate, make_sample
 
 TINY = SynthConfig(size=32, tex_size=16, shading_size=8)
 
@@ -85,6 +85,12 @@ def test_resume_refuses_a_set_whose_effective_grid_differs(tmp_path):
     path.write_text(json.dumps(old))
     with pytest.raises(ConfigError, match="effective"):
         generate(tmp_path, {"train": 1}, TINY, progress=False)
+
+
+def test_steady_rate_leaves_out_start_up_and_each_workers_first_sample():
+    s = SynthSummary(written=9, failed=[("test", "000001", "bad")], seconds=6.0, first_seconds=2.0, workers=2)
+    assert s.rate == pytest.approx(1.5) and s.steady_rate == pytest.approx(8 / 4)
+    assert SynthSummary(written=2, seconds=4.0, first_seconds=3.0, workers=2).steady_rate == pytest.approx(0.5)
 
 
 def test_make_sample_is_a_pure_function_of_seed_split_index():
