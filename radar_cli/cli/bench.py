@@ -86,8 +86,12 @@ def synth(size: int, n: int, workers: int, shading_size: int) -> None:
               help="Images de-rendered end to end with every export.")
 @click.option("--batch-size", default=8, show_default=True, type=click.IntRange(min=1))
 @click.option("--threads", default=1, show_default=True, type=click.IntRange(min=1), help="torch threads.")
-def derender(checkpoint: str | None, device: str, images: int, exports: int, batch_size: int, threads: int) -> None:
+@click.option("--workers", default=2, show_default=True, type=click.IntRange(min=0),
+              help="Threads cropping and exporting objects (radar derender --workers).")
+def derender(checkpoint: str | None, device: str, images: int, exports: int, batch_size: int, threads: int,
+             workers: int) -> None:
     """Images per second for the network alone and for the full de-rendering with all exports."""
     from radar_cli.derender.benchmark import bench_derender
 
-    click.echo(json.dumps(bench_derender(checkpoint, device, images, exports, batch_size, threads), indent=2))
+    click.echo(json.dumps(bench_derender(checkpoint, device, images, exports, batch_size, threads, workers=workers),
+                          indent=2))

@@ -35,7 +35,7 @@ from radar_cli.derender.predictor import Predictor
               help="Extra relighting environment map (.hdr, .exr, .png, .npy); repeatable.")
 @click.option("--batch-size", type=click.IntRange(1, 1024), default=8, show_default=True)
 @click.option("--workers", type=click.IntRange(0, 64), default=2, show_default=True,
-              help="Threads reading and cropping images.")
+              help="Threads reading and cropping images, and exporting objects.")
 @click.option("--threads", type=click.IntRange(1, 256), default=1, show_default=True,
               help="torch threads for the network (more helps only on an otherwise idle machine).")
 @click.option("--overwrite", is_flag=True, help="Redo objects whose folders are already complete.")

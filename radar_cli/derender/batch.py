@@ -167,13 +167,25 @@ def _run_batch(chunk: list[InputItem], predictor: Predictor, options: DerenderOp
 def _export_all(ok: list[tuple[InputItem, Prepared]], dec: Decomposition, predictor: Predictor,
                 options: DerenderOptions, envs: dict[str, np.ndarray], summary: BatchSummary,
                 say: Callable[[str], None]) -> None:
-    """Export each predicted object; an error costs that object only."""
-    for k, (item, prep) in enumerate(ok):
+    """Export each predicted object, options.workers at a time (threads: PNG and zlib encoding and torch's
+    operations release the GIL, and each object writes its own folder); an error costs that object only."""
+    def one(k: int) -> Failure | None:
+        item, prep = ok[k]
         try:
             export_object(options.out / item.name, item, prep, dec.select(k), predictor.setup,
                           predictor.version, envs, options.export)
-            summary.done.append(item.name)
         except ITEM_ERRORS as e:
-            failure = Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
+            return Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
+        return None
+
+    if options.workers <= 1 or len(ok) == 1:
+        results = [one(k) for k in range(len(ok))]
+    else:
+        with ThreadPoolExecutor(max_workers=min(options.workers, len(ok))) as pool:
+            results = list(pool.map(one, range(len(ok))))
+    for (item, _), failure in zip(ok, results):  # recorded in input order, whatever finished first
+        if failure is None:
+            summary.done.append(item.name)
+        else:
             summary.failures.append(failure)
             say(failure.line())

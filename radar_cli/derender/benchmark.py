@@ -53,7 +53,8 @@ def _network_rate(predictor: Predictor, images: list[np.ndarray], batch_size: in
 
 def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_images: int = 32,
                    n_export: int = 4, batch_size: int = 8, threads: int = 1,
-                   export: ExportConfig = ExportConfig(), predictor: Predictor | None = None) -> dict:
+                   export: ExportConfig = ExportConfig(), predictor: Predictor | None = None,
+                   workers: int = 2) -> dict:
     """Measure de-rendering speed.
 
     Args:
@@ -65,10 +66,11 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         threads: torch intra-op threads.
         export: turntable and view settings of the full run.
         predictor: use this instead of loading `checkpoint` (tests).
+        workers: threads cropping and exporting objects.
 
     Returns:
         {"network_images_per_s", "network_images_per_cpu_s", "full_images_per_s", "full_seconds_per_image",
-         "image_size", "batch_size", "n_images", "n_export", "device", "threads", "model"}.
+         "image_size", "batch_size", "n_images", "n_export", "device", "threads", "workers", "model"}.
     """
     predictor = predictor or Predictor.from_checkpoint(checkpoint, device)
     size = predictor.setup.image_size
@@ -78,7 +80,8 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
     with tempfile.TemporaryDirectory(prefix="radar-bench-") as tmp:
         for i, image in enumerate(_photos(n_export, size)):
             write_image(Path(tmp) / "in" / f"bench_{i:03d}.png", image)
-        options = DerenderOptions(out=Path(tmp) / "out", batch_size=batch_size, threads=threads, export=export)
+        options = DerenderOptions(out=Path(tmp) / "out", batch_size=batch_size, workers=workers, threads=threads,
+                                  export=export)
         start = time.perf_counter()
         summary = derender([Path(tmp) / "in"], predictor, options, say=lambda line: None)
         full = time.perf_counter() - start
@@ -94,5 +97,6 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         "n_export": n_export,
         "device": str(predictor.device),
         "threads": threads,
+        "workers": workers,
         "model": predictor.version,
     }

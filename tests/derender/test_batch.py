@@ -152,3 +152,33 @@ def test_incomplete_folder_is_redone(tmp_path: Path, predictor: Predictor) -> No
     summary = derender([tmp_path / "in"], predictor, DerenderOptions(out=tmp_path / "out",
                                                                       export=ExportConfig(0, 32)))
     assert summary.done == ["a"] and ResultPaths(tmp_path / "out" / "a").is_complete()
+
+
+def test_parallel_exports_write_the_same_bytes_and_keep_going_past_a_failure(tmp_path: Path, predictor: Predictor,
+                                                                              monkeypatch) -> None:
+    from radar_cli.derender import batch
+
+    for i, name in enumerate(["a", "b", "c", "d"]):
+        write_photo(tmp_path / "in" / f"{name}.png", 10 + i)
+    real = batch.export_object
+
+    def failing_c(folder, *args):
+        if folder.name == "c":
+            raise OSError("disk full")
+        return real(folder, *args)
+
+    monkeypatch.setattr(batch, "export_object", failing_c)
+    runs = {}
+    for workers in (1, 3):
+        options = DerenderOptions(out=tmp_path / f"out{workers}", workers=workers, export=ExportConfig(0, 32))
+        runs[workers] = derender([tmp_path / "in"], predictor, options, say=lambda _: None)
+    for summary in runs.values():
+        assert summary.done == ["a", "b", "d"]
+        assert [f.problem for f in summary.failures] == ["export failed (OSError: disk full)"]
+    for name in ("a", "b", "d"):
+        one, three = tmp_path / "out1" / name, tmp_path / "out3" / name
+        files = sorted(p.name for p in one.iterdir())
+        assert files == sorted(p.name for p in three.iterdir()) and "material.json" in files
+        for f in files:
+            if f != "material.json":  # it records the source path, which differs
+                assert (one / f).read_bytes() == (three / f).read_bytes(), f
