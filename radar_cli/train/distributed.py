@@ -89,7 +89,7 @@ def any_rank(flag: bool, info: DistInfo) -> bool:
     """True if `flag` is true on any rank (so all ranks stop together)."""
     if not info.enabled:
         return flag
-    t = torch.tensor([float(flag)])
+    t = torch.tensor([float(flag)], device=info.device)  # on the GPU under NCCL, which reduces no CPU tensors
     dist.all_reduce(t, op=dist.ReduceOp.MAX)
     return bool(t.item() > 0)
 
@@ -98,7 +98,7 @@ def mean_across(values: dict[str, float], info: DistInfo) -> dict[str, float]:
     """Average scalar metrics over ranks (for logging)."""
     if not info.enabled or not values:
         return values
-    t = torch.tensor(list(values.values()), dtype=torch.float64)
+    t = torch.tensor(list(values.values()), dtype=torch.float64, device=info.device)
     dist.all_reduce(t)
     return dict(zip(values, (t / info.world).tolist()))
 
