@@ -11,6 +11,9 @@ WORKERS ?= 2
 THREADS ?=
 # CPU training threads: empty keeps each preset's train.threads (1, for shared machines); THREADS=2 on an idle one
 TRAIN_THREADS := $(if $(THREADS),--threads $(THREADS),)
+# extra `radar train` options for train-syn and train-met, e.g. TRAIN_ARGS="--max-minutes 25" and later
+# TRAIN_ARGS="--max-minutes 25 --resume" to fit the 40k steps into a machine's time limit (status 3 = not finished)
+TRAIN_ARGS ?=
 
 .PHONY: install demo test test-all test-gpu clean \
         syn-data syn-data-cpu train-syn train-syn-cpu eval-syn eval-syn-cpu table2 table2-cpu \
@@ -48,11 +51,12 @@ syn-data: $(STAMP)
 	$(RADAR) synth --out data/syn_vases --size 256 --workers $(WORKERS)
 
 train-syn: $(STAMP)
-	$(RADAR) train --config pipelines/syn_vases.toml --data data/syn_vases --out runs/syn_vases --device $(DEVICE)
+	$(RADAR) train --config pipelines/syn_vases.toml --data data/syn_vases --out runs/syn_vases --device $(DEVICE) \
+		$(TRAIN_ARGS)
 
 eval-syn: $(STAMP)
 	$(RADAR) derender data/syn_vases/test --checkpoint runs/syn_vases/model.safetensors --out results/syn_vases \
-		--views 0 --device $(DEVICE)
+		--views 0 --device $(DEVICE) --workers $(WORKERS)
 	$(RADAR) eval --pred results/syn_vases --gt data/syn_vases --json results/syn_vases/eval.json
 
 # Every row of Table 2: the full model, the ablations and the supervised upper bound.
@@ -60,7 +64,7 @@ table2: $(STAMP)
 	for p in syn_vases syn_vases_no_alb syn_vases_no_sad syn_vases_no_diff syn_vases_supervised; do \
 		$(RADAR) train --config pipelines/$$p.toml --data data/syn_vases --out runs/$$p --device $(DEVICE) && \
 		$(RADAR) derender data/syn_vases/test --checkpoint runs/$$p/model.safetensors --out results/$$p \
-			--views 0 --device $(DEVICE) && \
+			--views 0 --device $(DEVICE) --workers $(WORKERS) && \
 		$(RADAR) eval --pred results/$$p --gt data/syn_vases --json results/$$p/eval.json || exit 1; \
 	done
 
@@ -111,7 +115,8 @@ met-masks: $(STAMP)
 	$(RADAR) masks data/met --out data/met_prepared --size 256 --workers $(WORKERS)
 
 train-met: $(STAMP)
-	$(RADAR) train --config pipelines/met_vases.toml --data data/met_prepared --out runs/met_vases --device $(DEVICE)
+	$(RADAR) train --config pipelines/met_vases.toml --data data/met_prepared --out runs/met_vases --device $(DEVICE) \
+		$(TRAIN_ARGS)
 
 # --- The 12 real photographs beside the repo, de-rendered by the bundled model, with a contact sheet ----------
 real-vases: $(STAMP)

@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+import sys
+
 import click
 
 from radar_cli.model.config import load_run_config
+
+
+OUT_OF_TIME_STATUS = 3
 
 
 @click.command("train")
@@ -24,7 +29,8 @@ from radar_cli.model.config import load_run_config
 @click.option("--threads", type=click.IntRange(min=1), default=None,
               help="Overrides train.threads (CPU threads; the CPU presets use 1 for shared machines).")
 @click.option("--max-minutes", type=click.FloatRange(min=0, min_open=True), default=None,
-              help="Wall-time budget: past it, write a checkpoint and stop (continue with --resume).")
+              help="Wall-time budget: past it, write a checkpoint and stop with exit status 3 (continue with "
+                   "--resume).")
 def train(config_path: str, data_dir: str, run_dir: str, resume: bool, device: str | None, overfit: int | None,
           iterations: int | None, init: str | None, threads: int | None, max_minutes: float | None) -> None:
     """Train the de-rendering model (shape, lighting, albedo networks + SAD discriminator)."""
@@ -38,5 +44,6 @@ def train(config_path: str, data_dir: str, run_dir: str, resume: bool, device: s
                f"({summary.sec_per_step:.3f} s/step)")
     click.echo(f"final losses: {losses}")
     click.echo(f"checkpoint: {summary.checkpoint}")
-    if summary.out_of_time:
+    if summary.out_of_time:  # not finished: status 3, so `radar train ... && radar derender ...` stops here
         click.echo(f"stopped by --max-minutes at step {summary.end}; continue with --resume")
+        sys.exit(OUT_OF_TIME_STATUS)

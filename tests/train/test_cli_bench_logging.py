@@ -36,6 +36,10 @@ def test_train_command_runs_the_cpu_preset(vases64, tmp_path):
                                        "--overfit", "4", "--iterations", "3", "--resume"])
     assert resumed.exit_code == 0, resumed.output
     assert "trained steps 2..3" in resumed.output
+    budget = CliRunner().invoke(cli, ["train", "--config", str(PRESET), "--data", str(vases64), "--out", str(run),
+                                      "--overfit", "4", "--iterations", "5", "--resume", "--max-minutes", "1e-9"])
+    assert budget.exit_code == 3, budget.output  # not finished: a `&& radar derender` chain stops here
+    assert "trained steps 3..4" in budget.output and "stopped by --max-minutes at step 4" in budget.output
 
 
 def test_train_command_errors_are_one_line(vases64, tmp_path):
