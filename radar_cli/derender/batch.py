@@ -11,7 +11,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from contextlib import contextmanager
-from typing import Callable, Iterator
+from typing import Callable, Iterator, Sequence, TypeVar
 
 import numpy as np
 import torch
@@ -25,6 +25,7 @@ from radar_cli.derender.report import write_report
 from radar_cli.errors import InputError, RadarError
 from radar_cli.model.outputs import Decomposition
 
+T, R = TypeVar("T"), TypeVar("R")
 EXPORT_THREADS = 1  # exports work on small tensors: one torch thread ran them 2-5x faster than two (2 cores)
 # errors of one object's export that must not stop the batch (decoding, writing, a degenerate prediction)
 ITEM_ERRORS = (RadarError, OSError, ValueError, RuntimeError)
@@ -85,6 +86,14 @@ def environments(paths: tuple[Path, ...], height: int, width: int) -> dict[str, 
     return envs
 
 
+def _thread_map(fn: Callable[[T], R], items: Sequence[T], workers: int) -> list[R]:
+    """[fn(x) for x in items], in order, on up to `workers` threads (in this thread when workers <= 1)."""
+    if workers <= 1 or len(items) <= 1:
+        return [fn(x) for x in items]
+    with ThreadPoolExecutor(max_workers=min(workers, len(items))) as pool:
+        return list(pool.map(fn, items))
+
+
 def _prepare_all(items: list[InputItem], size: int, options: DerenderOptions) -> list[Prepared | Failure]:
     """Read and crop a batch of inputs (threads: decoding and detection release the GIL)."""
     def one(item: InputItem) -> Prepared | Failure:
@@ -93,10 +102,7 @@ def _prepare_all(items: list[InputItem], size: int, options: DerenderOptions) ->
         except RadarError as e:
             return Failure(str(item.image_path), str(e).removeprefix(f"{item.image_path}: "))
 
-    if options.workers <= 1:
-        return [one(item) for item in items]
-    with ThreadPoolExecutor(max_workers=options.workers) as pool:
-        return list(pool.map(one, items))
+    return _thread_map(one, items, options.workers)
 
 
 def _pending(items: list[InputItem], out: Path, overwrite: bool, summary: BatchSummary,
@@ -178,12 +184,7 @@ def _export_all(ok: list[tuple[InputItem, Prepared]], dec: Decomposition, predic
             return Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
         return None
 
-    if options.workers <= 1 or len(ok) == 1:
-        results = [one(k) for k in range(len(ok))]
-    else:
-        with ThreadPoolExecutor(max_workers=min(options.workers, len(ok))) as pool:
-            results = list(pool.map(one, range(len(ok))))
-    for (item, _), failure in zip(ok, results):  # recorded in input order, whatever finished first
+    for (item, _), failure in zip(ok, _thread_map(one, range(len(ok)), options.workers)):  # recorded in input order, whatever finished first
         if failure is None:
             summary.done.append(item.name)
         else:

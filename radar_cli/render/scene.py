@@ -118,7 +118,7 @@ def render_synthetic(
 ) -> tuple[torch.Tensor, Hits, Shading]:
     """The whole object drawn as `radar synth` draws its images: shaded over the full 360 deg, the inside dimmed,
     anti-aliased by the soft silhouette within the hard one and the plain background everywhere off it (no soft
-    halo outside the object). Synthesis and the training's shape cycle both draw through this.
+    halo outside the object). Synthesis and the training's two cycles draw through this.
 
     Args:
         radius: B x L; height: B; pose: B x 4.
