@@ -14,6 +14,9 @@ TRAIN_THREADS := $(if $(THREADS),--threads $(THREADS),)
 # extra `radar train` options for train-syn and train-met, e.g. TRAIN_ARGS="--max-minutes 25" and later
 # TRAIN_ARGS="--max-minutes 25 --resume" to fit the 40k steps into a machine's time limit (status 3 = not finished)
 TRAIN_ARGS ?=
+# the albedo the evaluation targets score: the paper's Table 2 scores the albedo network's output (network);
+# ALBEDO=divided scores `radar derender`'s default, the input divided by the predicted shading
+ALBEDO ?= network
 
 .PHONY: install demo test test-all test-gpu clean \
         syn-data syn-data-cpu train-syn train-syn-cpu eval-syn eval-syn-cpu table2 table2-cpu \
@@ -56,7 +59,7 @@ train-syn: $(STAMP)
 
 eval-syn: $(STAMP)
 	$(RADAR) derender data/syn_vases/test --checkpoint runs/syn_vases/model.safetensors --out results/syn_vases \
-		--views 0 --device $(DEVICE) --workers $(WORKERS)
+		--views 0 --device $(DEVICE) --workers $(WORKERS) --albedo $(ALBEDO)
 	$(RADAR) eval --pred results/syn_vases --gt data/syn_vases --json results/syn_vases/eval.json
 
 # Every row of Table 2: the full model, the ablations and the supervised upper bound.
@@ -64,7 +67,7 @@ table2: $(STAMP)
 	for p in syn_vases syn_vases_no_alb syn_vases_no_sad syn_vases_no_diff syn_vases_supervised; do \
 		$(RADAR) train --config pipelines/$$p.toml --data data/syn_vases --out runs/$$p --device $(DEVICE) && \
 		$(RADAR) derender data/syn_vases/test --checkpoint runs/$$p/model.safetensors --out results/$$p \
-			--views 0 --device $(DEVICE) --workers $(WORKERS) && \
+			--views 0 --device $(DEVICE) --workers $(WORKERS) --albedo $(ALBEDO) && \
 		$(RADAR) eval --pred results/$$p --gt data/syn_vases --json results/$$p/eval.json || exit 1; \
 	done
 
@@ -97,13 +100,14 @@ train-syn-cpu: $(STAMP)
 
 eval-syn-cpu: $(STAMP)
 	$(RADAR) derender data/syn_cpu/test --checkpoint runs/syn_cpu_light/model.safetensors --out results/syn_cpu \
-		--views 0
+		--views 0 --albedo $(ALBEDO)
 	$(RADAR) eval --pred results/syn_cpu --gt data/syn_cpu --json results/syn_cpu/eval.json
 
 table2-cpu: $(STAMP)
 	for p in syn_vases_cpu syn_vases_cpu_no_alb syn_vases_cpu_no_sad syn_vases_cpu_no_diff syn_vases_cpu_supervised; do \
 		$(RADAR) train --config pipelines/$$p.toml --data data/syn_cpu --out runs/$$p --device cpu $(TRAIN_THREADS) && \
-		$(RADAR) derender data/syn_cpu/test --checkpoint runs/$$p/model.safetensors --out results/$$p --views 0 && \
+		$(RADAR) derender data/syn_cpu/test --checkpoint runs/$$p/model.safetensors --out results/$$p --views 0 \
+			--albedo $(ALBEDO) && \
 		$(RADAR) eval --pred results/$$p --gt data/syn_cpu --json results/$$p/eval.json || exit 1; \
 	done
 

@@ -88,10 +88,13 @@ def synth(size: int, n: int, workers: int, shading_size: int) -> None:
 @click.option("--threads", default=1, show_default=True, type=click.IntRange(min=1), help="torch threads.")
 @click.option("--workers", default=2, show_default=True, type=click.IntRange(min=0),
               help="Threads cropping and exporting objects (radar derender --workers).")
+@click.option("--albedo", type=click.Choice(["network", "divided"]), default="divided", show_default=True,
+              help="radar derender --albedo.")
 def derender(checkpoint: str | None, device: str, images: int, exports: int, batch_size: int, threads: int,
-             workers: int) -> None:
+             workers: int, albedo: str) -> None:
     """Images per second for the network alone and for the full de-rendering with all exports."""
     from radar_cli.derender.benchmark import bench_derender
 
-    click.echo(json.dumps(bench_derender(checkpoint, device, images, exports, batch_size, threads, workers=workers),
+    click.echo(json.dumps(bench_derender(checkpoint, device, images, exports, batch_size, threads, workers=workers,
+                                         albedo=albedo),  # type: ignore[arg-type]
                           indent=2))

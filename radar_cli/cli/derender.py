@@ -11,6 +11,7 @@ from radar_cli.derender.batch import DerenderOptions, derender as run_derender
 from radar_cli.derender.contact_sheet import contact_sheet as write_contact_sheet
 from radar_cli.derender.export import ExportConfig
 from radar_cli.derender.predictor import Predictor
+from radar_cli.derender.refine import ALBEDO_SOURCES
 
 
 @click.command("derender")
@@ -28,6 +29,9 @@ from radar_cli.derender.predictor import Predictor
               help="white: put the object on white through its silhouette (found by --crop auto, --masks or a "
                    "dataset's mask.png) before the network, as synthetic training images are; keep: as photographed.")
 @click.option("--device", default="auto", show_default=True, help="auto, cpu, cuda or cuda:N.")
+@click.option("--albedo", type=click.Choice(ALBEDO_SOURCES), default="divided", show_default=True,
+              help="divided: the photo's texture divided by the predicted shading (keeps painted detail); "
+                   "network: the albedo network's output, as the paper.")
 @click.option("--views", type=click.IntRange(0, 360), default=8, show_default=True, help="Turntable frames.")
 @click.option("--view-size", type=click.IntRange(16, 1024), default=128, show_default=True,
               help="Side in pixels of turntable frames, relit views and the material sphere.")
@@ -42,10 +46,10 @@ from radar_cli.derender.predictor import Predictor
 @click.option("--contact-sheet", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Also write a contact sheet PNG (input, reconstruction, albedo, relit view per object).")
 def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks: Path | None, crop: str,
-             backdrop: str, device: str, views: int, view_size: int, envs: tuple[Path, ...], batch_size: int,
+             backdrop: str, device: str, albedo: str, views: int, view_size: int, envs: tuple[Path, ...], batch_size: int,
              workers: int, threads: int, overwrite: bool, contact_sheet: Path | None) -> None:
     """De-render INPUTS (image files, folders, prepared dataset folders) into --out."""
-    predictor = Predictor.from_checkpoint(checkpoint, device)
+    predictor = Predictor.from_checkpoint(checkpoint, device, albedo)  # type: ignore[arg-type]
     options = DerenderOptions(out=out, crop=crop, backdrop=backdrop, masks=masks,  # type: ignore[arg-type]
                               envs=envs, batch_size=batch_size, workers=workers, threads=threads, overwrite=overwrite,
                               export=ExportConfig(views, view_size))

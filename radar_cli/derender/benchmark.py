@@ -13,6 +13,7 @@ import torch
 from radar_cli.derender.batch import DerenderOptions, derender, torch_threads
 from radar_cli.derender.export import ExportConfig
 from radar_cli.derender.predictor import Predictor
+from radar_cli.derender.refine import AlbedoSource
 from radar_cli.fileio import write_image
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -54,7 +55,7 @@ def _network_rate(predictor: Predictor, images: list[np.ndarray], batch_size: in
 def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_images: int = 32,
                    n_export: int = 4, batch_size: int = 8, threads: int = 1,
                    export: ExportConfig = ExportConfig(), predictor: Predictor | None = None,
-                   workers: int = 2) -> dict:
+                   workers: int = 2, albedo: AlbedoSource = "divided") -> dict:
     """Measure de-rendering speed.
 
     Args:
@@ -67,12 +68,13 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         export: turntable and view settings of the full run.
         predictor: use this instead of loading `checkpoint` (tests).
         workers: threads cropping and exporting objects.
+        albedo: the predictor's albedo source (`divided` adds the shading division to the network's time).
 
     Returns:
         {"network_images_per_s", "network_images_per_cpu_s", "full_images_per_s", "full_seconds_per_image",
-         "image_size", "batch_size", "n_images", "n_export", "device", "threads", "workers", "model"}.
+         "image_size", "batch_size", "n_images", "n_export", "device", "threads", "workers", "albedo", "model"}.
     """
-    predictor = predictor or Predictor.from_checkpoint(checkpoint, device)
+    predictor = predictor or Predictor.from_checkpoint(checkpoint, device, albedo)
     size = predictor.setup.image_size
     images = _photos(n_images, size)
     with torch_threads(threads):
@@ -98,5 +100,6 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         "device": str(predictor.device),
         "threads": threads,
         "workers": workers,
+        "albedo": predictor.albedo,
         "model": predictor.version,
     }

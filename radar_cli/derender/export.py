@@ -35,7 +35,8 @@ def is_complete(folder: Path) -> bool:
 
 
 def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomposition, setup: ModelSetup,
-                  version: str, envs: dict[str, np.ndarray], config: ExportConfig = ExportConfig()) -> dict:
+                  version: str, envs: dict[str, np.ndarray], config: ExportConfig = ExportConfig(),
+                  albedo_source: str = "network") -> dict:
     """Write all files of one object.
 
     Args:
@@ -46,6 +47,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomp
         version: model label for material.json.
         envs: relighting environments by name (He x We each).
         config: turntable and view settings.
+        albedo_source: where the albedo came from (`network` or `divided`, see radar_cli.derender.refine).
 
     Returns:
         The material.json record.
@@ -65,6 +67,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomp
         "backdrop": prepared.backdrop,
         "image_size": setup.image_size,
         "model": version,
+        "albedo_source": albedo_source,
         "environments": sorted(envs),
     })
     write_json(folder / MATERIAL_FILE, record)

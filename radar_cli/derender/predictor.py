@@ -12,6 +12,7 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig
+from radar_cli.derender.refine import ALBEDO_SOURCES, AlbedoSource, divide_shading
 from radar_cli.errors import CheckpointError, InputError
 from radar_cli.model.outputs import Decomposition
 
@@ -60,17 +61,23 @@ class Predictor:
         setup: the model's render, camera and geometry configuration.
         version: a label recorded in every material.json (checkpoint name and hash).
         device: where the model runs.
+        albedo: `divided`: the input's texture divided by the predicted shading (radar_cli.derender.refine);
+            `network`: f_A's albedo, as the paper.
     """
 
     def __init__(self, model: Callable[[torch.Tensor], Decomposition], setup: ModelSetup, version: str,
-                 device: torch.device | str = "cpu"):
+                 device: torch.device | str = "cpu", albedo: AlbedoSource = "divided"):
+        if albedo not in ALBEDO_SOURCES:
+            raise InputError(f"unknown albedo source {albedo!r} (use {' or '.join(ALBEDO_SOURCES)})")
         self.model = model
         self.setup = setup
         self.version = version
         self.device = torch.device(device)
+        self.albedo = albedo
 
     @classmethod
-    def from_checkpoint(cls, path: str | Path | None = None, device: str = "auto") -> "Predictor":
+    def from_checkpoint(cls, path: str | Path | None = None, device: str = "auto",
+                        albedo: AlbedoSource = "divided") -> "Predictor":
         """Load a checkpoint (default: the bundled model); CheckpointError if it is missing or does not fit."""
         path = Path(path) if path is not None else bundled_checkpoint()
         if not path.is_file():
@@ -84,7 +91,7 @@ class Predictor:
         model.eval()
         cfg = model.config
         setup = ModelSetup(cfg.render, cfg.camera, cfg.geometry)
-        return cls(model, setup, f"{path.name}#{_short_hash(path)}", dev)
+        return cls(model, setup, f"{path.name}#{_short_hash(path)}", dev, albedo)
 
     @torch.no_grad()
     def predict(self, images: list[np.ndarray]) -> Decomposition:
@@ -102,7 +109,10 @@ class Predictor:
                 raise InputError(f"expected {size} x {size} x 3 uint8 crops, got {im.shape} {im.dtype}")
         batch = torch.from_numpy(np.stack(images)).permute(0, 3, 1, 2)  # B x 3 x S x S uint8
         batch = batch.to(self.device, torch.float32) / 255.0
-        return self.model(batch).detach().to("cpu")
+        dec = self.model(batch)
+        if self.albedo == "divided":
+            dec = divide_shading(batch, dec, self.setup.render, self.setup.camera)
+        return dec.detach().to("cpu")
 
 
 def _short_hash(path: Path) -> str:

@@ -195,6 +195,30 @@ def compose(
     return tone_map(albedo * d + rho[:, None, None, None] * s, gamma)
 
 
+def decompose(
+    texture: torch.Tensor, diffuse: torch.Tensor, specular: torch.Tensor, rho: torch.Tensor,
+    gamma: float = GAMMA, max_specular_share: float = 1.0,
+) -> torch.Tensor:
+    """The albedo that `compose` turns into `texture` under the given shading: A = (tau^-1(T) - rho I_s) / I_d.
+
+    The specular part taken away is capped at `max_specular_share` of the texel's linear radiance, so a
+    highlight the shading overestimates leaves a dimmed albedo instead of a black hole; the result is clamped to
+    [0, 1] (where the diffuse factor is ~0 the albedo is unknown and comes out 1 or 0).
+
+    Args:
+        texture: B x 3 x Ht x Wt tone-mapped texture in [0, 1].
+        diffuse, specular: B x 1 x Ht x Wt (or B x Ht x Wt) linear shading factors; rho: B specular albedo.
+
+    Returns:
+        B x 3 x Ht x Wt linear albedo in [0, 1].
+    """
+    d = diffuse if diffuse.dim() == 4 else diffuse[:, None]
+    s = specular if specular.dim() == 4 else specular[:, None]
+    radiance = power(texture.clamp_min(EPS), gamma)
+    highlight = torch.minimum(rho[:, None, None, None] * s, max_specular_share * radiance)
+    return ((radiance - highlight) / d.clamp_min(EPS)).clamp(0.0, 1.0)
+
+
 def upsample(x: torch.Tensor, size: tuple[int, int]) -> torch.Tensor:
     """Bilinear upsampling of B x H x W (or B x C x H x W) maps from the shading grid to texture size."""
     squeeze = x.dim() == 3

@@ -8,11 +8,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import torch
 from click.testing import CliRunner
 
 from radar_cli.cli import cli
 from radar_cli.derender.predictor import Predictor
-from radar_cli.errors import CheckpointError
+from radar_cli.errors import CheckpointError, InputError
 
 from .conftest import write_photo
 
@@ -53,6 +54,19 @@ def test_tiny_model_predicts(tmp_path: Path) -> None:
     assert not dec.radius.requires_grad
 
 
+def test_albedo_sources(tmp_path: Path) -> None:
+    path = save_weights(tmp_path / "tiny.safetensors", tiny_config())
+    images = [np.random.default_rng(1).integers(0, 256, (32, 32, 3), dtype=np.uint8)] * 2
+    network = Predictor.from_checkpoint(path, "cpu", albedo="network").predict(images)
+    divided = Predictor.from_checkpoint(path, "cpu").predict(images)  # the default
+    for name in ("radius", "height", "pose", "env", "alpha", "rho"):
+        assert torch.equal(getattr(network, name), getattr(divided, name))  # only the albedo is refined
+    assert divided.albedo.shape == network.albedo.shape and not torch.allclose(divided.albedo, network.albedo)
+    assert divided.albedo.min() >= 0 and divided.albedo.max() <= 1
+    with pytest.raises(InputError, match="albedo source"):
+        Predictor.from_checkpoint(path, "cpu", albedo="painted")  # type: ignore[arg-type]
+
+
 def test_cli_with_a_real_checkpoint(tmp_path: Path) -> None:
     path = save_weights(tmp_path / "tiny.safetensors", tiny_config())
     write_photo(tmp_path / "in" / "a.png", 1, (80, 80))
@@ -62,6 +76,11 @@ def test_cli_with_a_real_checkpoint(tmp_path: Path) -> None:
     assert result.exit_code == 0, result.output
     material = json.loads((tmp_path / "out" / "a" / "material.json").read_text())
     assert material["model"].startswith("tiny.safetensors#") and material["image_size"] == 32
+    assert material["albedo_source"] == "divided"
+    result = CliRunner().invoke(cli, ["derender", str(tmp_path / "in"), "--out", str(tmp_path / "net"),
+                                      "--checkpoint", str(path), "--views", "0", "--albedo", "network"])
+    assert result.exit_code == 0, result.output
+    assert json.loads((tmp_path / "net" / "a" / "material.json").read_text())["albedo_source"] == "network"
 
 
 def test_checkpoint_from_another_config_is_one_clear_error(tmp_path: Path) -> None:

@@ -8,7 +8,7 @@ import torch
 
 from radar_cli.config import RenderConfig
 from radar_cli.render import lighting
-from radar_cli.render.lighting import compose, env_directions, power, shading_factors, tone_map
+from radar_cli.render.lighting import compose, decompose, env_directions, power, shading_factors, tone_map
 from radar_cli.render.scene import shade
 
 HE, WE = 16, 48
@@ -66,6 +66,30 @@ def test_compose_is_tone_mapped_sum():
     out = compose(albedo, diffuse, specular, rho)
     ref = (albedo * diffuse[:, None] + rho[:, None, None, None] * specular[:, None]) ** (1 / 2.2)
     assert torch.allclose(out, ref, atol=1e-5)
+
+
+def test_decompose_inverts_compose():
+    g = torch.Generator().manual_seed(0)
+    albedo = torch.rand(2, 3, 5, 7, generator=g) * 0.9 + 0.05  # B x 3 x Ht x Wt
+    diffuse = torch.rand(2, 1, 5, 7, generator=g) + 0.2
+    specular = torch.rand(2, 1, 5, 7, generator=g) * 0.3
+    rho = torch.tensor([0.5, 1.2])
+    texture = compose(albedo, diffuse, specular, rho)
+    assert torch.allclose(decompose(texture, diffuse, specular, rho), albedo, atol=1e-5)
+    # B x Ht x Wt shading maps are taken as compose takes them
+    assert torch.allclose(decompose(texture, diffuse[:, 0], specular[:, 0], rho), albedo, atol=1e-5)
+
+
+def test_decompose_caps_the_highlight_and_clamps():
+    texture = torch.full((1, 3, 1, 2), 0.5)
+    radiance = 0.5**2.2
+    # a highlight twice the whole radiance: only 80% of the radiance is taken as highlight, not all of it
+    specular = torch.full((1, 1, 1, 2), 2 * radiance)
+    albedo = decompose(texture, torch.ones(1, 1, 1, 2), specular, torch.ones(1), max_specular_share=0.8)
+    assert torch.allclose(albedo, torch.full_like(albedo, 0.2 * radiance), atol=1e-6)
+    # no diffuse light on a lit texel: the albedo is unknown and clamped into [0, 1]
+    dark = decompose(texture, torch.zeros(1, 1, 1, 2), torch.zeros(1, 1, 1, 2), torch.ones(1))
+    assert dark.min() >= 0 and dark.max() <= 1
 
 
 def test_fast_forward_and_autograd_paths_match_the_direct_sum(monkeypatch):
