@@ -165,7 +165,7 @@ def _run_batch(chunk: list[InputItem], predictor: Predictor, options: DerenderOp
             ok.append((item, prep))
     if not ok:
         return
-    dec = predictor.predict([prep.image for _, prep in ok])
+    dec = predictor.predict([prep.image for _, prep in ok], [prep.silhouette for _, prep in ok])
     with torch_threads(EXPORT_THREADS):
         _export_all(ok, dec, predictor, options, envs, summary, say)
 

@@ -57,12 +57,14 @@ class Prepared:
         crop: the square window of the original photo the crop shows (x0, y0, side in its pixels).
         photo_size: (width, height) of the original photo after EXIF orientation.
         backdrop: `white` if the backdrop was replaced by white, else `kept`.
+        silhouette: S x S bool object mask of the crop, when known (located, --masks or the dataset's mask.png).
     """
 
     image: np.ndarray
     crop: CropBox
     photo_size: tuple[int, int]
     backdrop: str = "kept"
+    silhouette: np.ndarray | None = None
 
 
 def _is_image(path: Path) -> bool:
@@ -235,5 +237,5 @@ def prepare(item: InputItem, size: int, crop: CropMode = "auto", backdrop: Backd
         image = cut(photo, box, size)
         silhouette = None if mask is None else cut(mask.astype(np.uint8) * 255, box, size) > 127
     if backdrop == "white" and silhouette is not None:
-        return Prepared(white_backdrop(image, silhouette), box, (w, h), "white")
-    return Prepared(np.ascontiguousarray(image), box, (w, h))
+        return Prepared(white_backdrop(image, silhouette), box, (w, h), "white", silhouette)
+    return Prepared(np.ascontiguousarray(image), box, (w, h), silhouette=silhouette)

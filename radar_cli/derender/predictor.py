@@ -94,11 +94,14 @@ class Predictor:
         return cls(model, setup, f"{path.name}#{_short_hash(path)}", dev, albedo)
 
     @torch.no_grad()
-    def predict(self, images: list[np.ndarray]) -> Decomposition:
+    def predict(self, images: list[np.ndarray],
+                silhouettes: list[np.ndarray | None] | None = None) -> Decomposition:
         """De-render a batch of crops.
 
         Args:
             images: S x S x 3 uint8 RGB crops, S = setup.image_size.
+            silhouettes: per crop, its S x S bool object mask or None; the divided albedo keeps the network's
+                where the predicted surface unwraps from off the object.
 
         Returns:
             Decomposition of the batch, on the CPU, detached.
@@ -111,8 +114,18 @@ class Predictor:
         batch = batch.to(self.device, torch.float32) / 255.0
         dec = self.model(batch)
         if self.albedo == "divided":
-            dec = divide_shading(batch, dec, self.setup.render, self.setup.camera)
+            coverage = None if silhouettes is None else _coverage(silhouettes, size).to(self.device)
+            dec = divide_shading(batch, dec, self.setup.render, self.setup.camera, coverage)
         return dec.detach().to("cpu")
+
+
+def _coverage(silhouettes: list[np.ndarray | None], size: int) -> torch.Tensor:
+    """B x 1 x S x S float object coverage: each S x S mask, or all ones where none is known."""
+    masks = [np.ones((size, size), bool) if m is None else m for m in silhouettes]
+    for m in masks:
+        if m.shape != (size, size):
+            raise InputError(f"expected {size} x {size} silhouettes, got {m.shape}")
+    return torch.from_numpy(np.stack(masks).astype(np.float32))[:, None]
 
 
 def _short_hash(path: Path) -> str:

@@ -35,6 +35,7 @@ def test_dataset_sample_used_whole(tmp_path: Path) -> None:
     (item,), _ = collect_inputs([tmp_path])
     prepared = prepare(item, SIZE)
     assert prepared.crop.to_list() == [0, 0, 128] and prepared.image.shape == (SIZE, SIZE, 3)
+    assert prepared.silhouette is not None and prepared.silhouette.all()  # its mask.png, cut like the image
 
 
 def test_dataset_splits_and_split_folder(tmp_path: Path) -> None:
@@ -103,3 +104,7 @@ def test_white_backdrop_through_the_silhouette(tmp_path: Path) -> None:
     assert tuple(kept.image[1, 1]) == (225, 150, 225) and tuple(white.image[1, 1]) == (255, 255, 255)
     centre = (slice(SIZE // 2 - 4, SIZE // 2 + 4),) * 2
     np.testing.assert_array_equal(white.image[centre], kept.image[centre])  # the object itself is untouched
+    for prepared in (kept, white):  # the located silhouette travels with the crop, for the divided albedo
+        assert prepared.silhouette is not None and prepared.silhouette.shape == (SIZE, SIZE)
+        assert prepared.silhouette[centre].all() and not prepared.silhouette[1, 1]
+    assert prepare(item, SIZE, crop="none").silhouette is None  # nothing located, nothing known

@@ -63,6 +63,12 @@ def test_albedo_sources(tmp_path: Path) -> None:
         assert torch.equal(getattr(network, name), getattr(divided, name))  # only the albedo is refined
     assert divided.albedo.shape == network.albedo.shape and not torch.allclose(divided.albedo, network.albedo)
     assert divided.albedo.min() >= 0 and divided.albedo.max() <= 1
+    # texels that unwrap from off the object keep the network's albedo; no silhouette counts as all object
+    predictor = Predictor.from_checkpoint(path, "cpu")
+    off = predictor.predict(images, [np.zeros((32, 32), bool), None])
+    assert torch.allclose(off.albedo[0], network.albedo[0]) and torch.allclose(off.albedo[1], divided.albedo[1])
+    with pytest.raises(InputError, match="silhouettes"):
+        predictor.predict(images, [np.ones((16, 16), bool), None])
     with pytest.raises(InputError, match="albedo source"):
         Predictor.from_checkpoint(path, "cpu", albedo="painted")  # type: ignore[arg-type]
 
