@@ -46,8 +46,8 @@ from radar_cli.derender.refine import ALBEDO_SOURCES
 @click.option("--contact-sheet", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Also write a contact sheet PNG (input, reconstruction, albedo, relit view per object).")
 def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks: Path | None, crop: str,
-             backdrop: str, device: str, albedo: str, views: int, view_size: int, envs: tuple[Path, ...], batch_size: int,
-             workers: int, threads: int, overwrite: bool, contact_sheet: Path | None) -> None:
+             backdrop: str, device: str, albedo: str, views: int, view_size: int, envs: tuple[Path, ...],
+             batch_size: int, workers: int, threads: int, overwrite: bool, contact_sheet: Path | None) -> None:
     """De-render INPUTS (image files, folders, prepared dataset folders) into --out."""
     predictor = Predictor.from_checkpoint(checkpoint, device, albedo)  # type: ignore[arg-type]
     options = DerenderOptions(out=out, crop=crop, backdrop=backdrop, masks=masks,  # type: ignore[arg-type]

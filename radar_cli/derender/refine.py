@@ -3,8 +3,8 @@
 f_A's albedo is smooth and does not reproduce its own input: on the bundled model's test vases the frontal texture
 rebuilt from the prediction misses the unwrapped input by 26% of its radiance on average. Inverting Eq. 5 with the
 predicted shape, lighting and material (`radar_cli.render.lighting.decompose`) gives an albedo that keeps the
-photograph's painted detail and reconstructs it exactly, at the price of any shading the lighting failed to
-explain (README, Accuracy: albedo si-MSE 4.01 -> 2.33 x 1e-2 on the 460 test vases).
+photograph's painted detail and reconstructs it (up to the highlight cap, the [0, 1] clamp and resampling), at the
+price of any shading the lighting failed to explain (README, Accuracy: albedo si-MSE 4.01 -> 2.33 x 1e-2 on the 460 test vases).
 """
 
 from __future__ import annotations
