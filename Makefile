@@ -75,10 +75,10 @@ table2: $(STAMP)
 syn-data-cpu: $(STAMP)
 	$(RADAR) synth --out data/syn_cpu --size 64 --workers $(WORKERS)
 
-# The bundled model's six stages: the paper's losses, then a sharp silhouette, then the mouth term, then the
+# The bundled model's seven stages: the paper's losses, then a sharp silhouette, then the mouth term, then the
 # mouth term continued with a second learning-rate ramp (resumed from stage 3's last checkpoint), then the shape
-# cycle (a fine-tune of stage 4), then the lighting cycle as well (a fine-tune of stage 5); --resume continues a
-# killed fine-tune.
+# cycle (a fine-tune of stage 4), then the lighting cycle as well (a fine-tune of stage 5), then both cycles
+# redrawing with the divided albedo (a fine-tune of stage 6); --resume continues a killed fine-tune.
 train-syn-cpu: $(STAMP)
 	$(RADAR) train --config pipelines/syn_vases_cpu.toml --data data/syn_cpu --out runs/syn_cpu --device cpu $(TRAIN_THREADS)
 	$(RADAR) train --config pipelines/syn_vases_cpu_sharp.toml --init runs/syn_cpu/checkpoints/step_0006500.safetensors \
@@ -97,9 +97,12 @@ train-syn-cpu: $(STAMP)
 	$(RADAR) train --config pipelines/syn_vases_cpu_light.toml --resume \
 		--init runs/syn_cpu_cycle/checkpoints/step_0004000.safetensors --data data/syn_cpu \
 		--out runs/syn_cpu_light --device cpu $(TRAIN_THREADS)
+	$(RADAR) train --config pipelines/syn_vases_cpu_divided.toml --resume \
+		--init runs/syn_cpu_light/checkpoints/step_0004000.safetensors --data data/syn_cpu \
+		--out runs/syn_cpu_divided --device cpu $(TRAIN_THREADS)
 
 eval-syn-cpu: $(STAMP)
-	$(RADAR) derender data/syn_cpu/test --checkpoint runs/syn_cpu_light/model.safetensors --out results/syn_cpu \
+	$(RADAR) derender data/syn_cpu/test --checkpoint runs/syn_cpu_divided/model.safetensors --out results/syn_cpu \
 		--views 0 --albedo $(ALBEDO)
 	$(RADAR) eval --pred results/syn_cpu --gt data/syn_cpu --json results/syn_cpu/eval.json
 

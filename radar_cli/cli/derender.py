@@ -10,8 +10,7 @@ import click
 from radar_cli.derender.batch import DerenderOptions, derender as run_derender
 from radar_cli.derender.contact_sheet import contact_sheet as write_contact_sheet
 from radar_cli.derender.export import ExportConfig
-from radar_cli.derender.predictor import Predictor
-from radar_cli.derender.refine import ALBEDO_SOURCES
+from radar_cli.derender.predictor import ALBEDO_SOURCES, Predictor
 
 
 @click.command("derender")

@@ -12,8 +12,7 @@ import torch
 
 from radar_cli.derender.batch import DerenderOptions, derender, torch_threads
 from radar_cli.derender.export import ExportConfig
-from radar_cli.derender.predictor import Predictor
-from radar_cli.derender.refine import AlbedoSource
+from radar_cli.derender.predictor import AlbedoSource, Predictor
 from radar_cli.fileio import write_image
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"

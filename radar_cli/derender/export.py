@@ -47,7 +47,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomp
         version: model label for material.json.
         envs: relighting environments by name (He x We each).
         config: turntable and view settings.
-        albedo_source: where the albedo came from (`network` or `divided`, see radar_cli.derender.refine).
+        albedo_source: where the albedo came from (`network` or `divided`, see Predictor).
 
     Returns:
         The material.json record.

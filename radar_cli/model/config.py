@@ -90,6 +90,10 @@ class LossConfig:
     """Weight of the lighting cycle (radar's addition; 0 = off, the paper): the prediction, re-rendered whole at
     its own pose under another object's predicted environment map and specular albedo and a random shininess,
     must give back that lighting and material (f_L) and its own albedo (f_A) (step.light_cycle_term)."""
+    cycle_albedo: Literal["network", "divided"] = "network"
+    """The albedo the two cycles redraw with (and f_A must give back): f_A's own (`network`), or the input's
+    unwrapped texture divided by the predicted shading (`divided`, render.scene.divide_shading, as `radar derender`
+    exports it), which carries the photo's detail, so f_A is taught to keep it."""
     sad_patch: int = 64
     """Side of the albedo patches shown to the discriminator (a power of two >= 8)."""
     sad_patches_per_image: int = 4

@@ -5,6 +5,7 @@ Kept apart from the loop so tests, the benchmark and the trainer share exactly t
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import torch
@@ -17,7 +18,7 @@ from radar_cli.model.radar import RadarModel
 from radar_cli.render.lighting import compose, tone_map
 from radar_cli.render.mouth import coverage, coverage_above, mouth_margin
 from radar_cli.render.raycast import Hits, cast_rays
-from radar_cli.render.scene import Shading, render_front, render_synthetic, shade
+from radar_cli.render.scene import Shading, divide_shading, render_front, render_synthetic, shade
 from radar_cli.render.texture import full_from_front
 
 
@@ -133,6 +134,17 @@ def shape_cycle_term(shape_net: nn.Module, pred: Decomposition, background: torc
     return sum(terms.values())
 
 
+@torch.no_grad()
+def divided_prediction(pred: Decomposition, batch: Batch, config: RunConfig) -> Decomposition:
+    """The prediction, detached, with its albedo replaced by the batch's images divided by its shading
+    (render.scene.divide_shading, the true silhouette as the coverage): what the cycles redraw with under
+    loss.cycle_albedo = "divided"."""
+    m = config.model
+    target = pred.detach()
+    albedo = divide_shading(batch.image, *target.as_tuple(), m.render, m.camera, batch.mask[:, None])
+    return dataclasses.replace(target, albedo=albedo)
+
+
 def relit(pred: Decomposition, alpha: torch.Tensor) -> Decomposition:
     """Each object of a batch with the previous one's environment map and specular albedo (rolled by one) and the
     given shininess (B)."""
@@ -216,11 +228,12 @@ def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig, disc:
         if model is None:
             raise ValueError("loss.cycle_weight or loss.light_cycle_weight > 0 needs the model")
         background = background_colour(batch.image, batch.mask)
+        drawn = divided_prediction(pred, batch, config) if lc.cycle_albedo == "divided" else pred
     if lc.cycle_weight > 0:
-        terms["cycle"] = shape_cycle_term(model.shape_net, pred, background, config)
+        terms["cycle"] = shape_cycle_term(model.shape_net, drawn, background, config)
         total = total + lc.cycle_weight * terms["cycle"]
     if lc.light_cycle_weight > 0:
-        terms["light_cycle"] = light_cycle_term(model, pred, background, config)
+        terms["light_cycle"] = light_cycle_term(model, drawn, background, config)
         total = total + lc.light_cycle_weight * terms["light_cycle"]
     terms["total"] = total
     return terms, Rendered(hits, shading, recon, front, real, fake)

@@ -3,18 +3,22 @@ the lighting cycle (loss.light_cycle_weight; only f_L and f_A learn from it)."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 import torch
 
 from radar_cli.errors import ConfigError
+from radar_cli.model.config import load_run_config
 from radar_cli.model import losses as L
 from radar_cli.model.outputs import Decomposition
 from radar_cli.model.radar import RadarModel
 from radar_cli.render.lighting import tone_map
 from radar_cli.render.texture import full_from_front
 from radar_cli.synth.render import render_sample
-from radar_cli.train.step import background_colour, generator_losses, light_cycle_term, redraw, relit
+from radar_cli.train.step import (Batch, background_colour, divided_prediction, generator_losses, light_cycle_term,
+                                  redraw, relit)
 
 from .conftest import box_batch, tiny_config
 
@@ -177,3 +181,33 @@ def test_light_cycle_is_learnable(light_setup):
 def test_negative_light_cycle_weight_is_rejected():
     with pytest.raises(ConfigError, match="light_cycle_weight"):
         tiny_config(light_cycle_weight=-0.5)
+
+
+def test_cycles_can_redraw_with_the_divided_albedo():
+    """loss.cycle_albedo = "divided": the cycles redraw the prediction with the input divided by its shading
+    (detached, in [0, 1], f_A's albedo kept where the true silhouette is off), and train the same networks."""
+    config, model, batch = _model_and_batch(cycle_weight=1.0, light_cycle_weight=1.0, cycle_albedo="divided")
+    pred = model(batch.image)
+    divided = divided_prediction(pred, batch, config)
+    assert not divided.albedo.requires_grad and divided.albedo.shape == pred.albedo.shape
+    assert 0 <= divided.albedo.min() and divided.albedo.max() <= 1
+    assert not torch.allclose(divided.albedo, pred.albedo.detach())
+    for kept in ("radius", "height", "pose", "env", "alpha", "rho"):
+        assert torch.equal(getattr(divided, kept), getattr(pred, kept).detach())
+    off = Batch(batch.image, torch.zeros_like(batch.mask), batch.dt)
+    assert torch.allclose(divided_prediction(pred, off, config).albedo, pred.albedo.detach())
+    torch.manual_seed(2)
+    terms, _ = generator_losses(pred, batch, config, None, model)
+    torch.manual_seed(2)
+    network = dataclasses.replace(config, loss=dataclasses.replace(config.loss, cycle_albedo="network"))
+    plain, _ = generator_losses(model(batch.image), batch, network, None, model)
+    assert terms["light_cycle"].item() != plain["light_cycle"].item()  # another albedo redrawn and asked back
+    (terms["cycle"] + terms["light_cycle"]).backward()
+    assert _networks_with_gradients(model) == {"shape_net", "light_net", "albedo_net"}
+
+
+def test_unknown_cycle_albedo_is_rejected(tmp_path):
+    path = tmp_path / "run.toml"
+    path.write_text('[loss]\ncycle_albedo = "painted"\n')
+    with pytest.raises(ConfigError, match="cycle_albedo"):
+        load_run_config(path)
