@@ -184,7 +184,8 @@ def _export_all(ok: list[tuple[InputItem, Prepared]], dec: Decomposition, predic
             return Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
         return None
 
-    for (item, _), failure in zip(ok, _thread_map(one, range(len(ok)), options.workers)):  # recorded in input order, whatever finished first
+    # recorded in input order, whatever finished first
+    for (item, _), failure in zip(ok, _thread_map(one, range(len(ok)), options.workers)):
         if failure is None:
             summary.done.append(item.name)
         else:

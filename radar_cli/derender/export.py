@@ -11,7 +11,7 @@ import numpy as np
 from radar_cli.derender.inputs import InputItem, Prepared
 from radar_cli.derender.maps import write_maps
 from radar_cli.derender.mesh import write_meshes
-from radar_cli.derender.predictor import ModelSetup
+from radar_cli.derender.predictor import AlbedoSource, ModelSetup
 from radar_cli.derender.renders import write_renders
 from radar_cli.derender.state import ObjectState
 from radar_cli.fileio import write_image, write_json
@@ -36,7 +36,7 @@ def is_complete(folder: Path) -> bool:
 
 def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomposition, setup: ModelSetup,
                   version: str, envs: dict[str, np.ndarray], config: ExportConfig = ExportConfig(),
-                  albedo_source: str = "network") -> dict:
+                  albedo_source: AlbedoSource = "network") -> dict:
     """Write all files of one object.
 
     Args:

@@ -15,7 +15,7 @@ import torch
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig
 from radar_cli.errors import CheckpointError, InputError
 from radar_cli.model.outputs import Decomposition
-from radar_cli.render.scene import divide_shading
+from radar_cli.render.scene import divide_shading, shade
 
 ASSETS = Path(__file__).resolve().parents[1] / "assets"
 AlbedoSource = Literal["network", "divided"]
@@ -119,7 +119,10 @@ class Predictor:
         dec = self.model(batch)
         if self.albedo == "divided":
             coverage = None if silhouettes is None else _coverage(silhouettes, size).to(self.device)
-            albedo = divide_shading(batch, *dec.as_tuple(), self.setup.render, self.setup.camera, coverage)
+            render, camera = self.setup.render, self.setup.camera
+            shading = shade(*dec.as_tuple(), render, camera)
+            albedo = divide_shading(batch, dec.radius, dec.height, dec.pose, dec.albedo, dec.rho, shading, render,
+                                    camera, coverage)
             dec = dataclasses.replace(dec, albedo=albedo)
         return dec.detach().to("cpu")
 

@@ -114,9 +114,8 @@ def divide_shading(
     height: torch.Tensor,
     pose: torch.Tensor,
     albedo: torch.Tensor,
-    env: torch.Tensor,
-    alpha: torch.Tensor,
     rho: torch.Tensor,
+    shading: Shading,
     render: RenderConfig,
     camera: CameraConfig,
     silhouette: torch.Tensor | None = None,
@@ -129,9 +128,10 @@ def divide_shading(
     Args:
         image: B x 3 x S x S tone-mapped image in [0, 1].
         radius: B x L; height: B; pose: B x 4 (the predicted shape and pose).
-        albedo: B x 3 x Ht x Wt the predicted albedo: the shading grid's size, and the fallback off the object.
-        env: B x He x We; alpha, rho: B (the predicted lighting and material).
-        render, camera: the model's settings (texture size, shading grid, gamma).
+        albedo: B x 3 x Ht x Wt the predicted albedo, the fallback off the object.
+        rho: B predicted specular albedo.
+        shading: `shade` of that prediction over the frontal third (the caller usually has it already).
+        render, camera: the model's settings (texture size, gamma).
         silhouette: B x 1 x S x S object coverage in [0, 1] if known: texels that unwrap from off the object
             (where the predicted outline overhangs the true one) would divide the backdrop, so they keep `albedo`,
             blended by the coverage.
@@ -141,7 +141,6 @@ def divide_shading(
     """
     stacked = image if silhouette is None else torch.cat([image, silhouette], dim=1)  # B x (3 or 4) x S x S
     unwrapped = unwrap(radius, height, pose, stacked, (render.tex_height, render.tex_width), camera)
-    shading = shade(radius, height, pose, albedo, env, alpha, rho, render, camera)
     divided = decompose(unwrapped[:, :3], shading.diffuse, shading.specular, rho, render.gamma, max_specular_share)
     if silhouette is None:
         return divided

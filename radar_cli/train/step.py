@@ -135,13 +135,14 @@ def shape_cycle_term(shape_net: nn.Module, pred: Decomposition, background: torc
 
 
 @torch.no_grad()
-def divided_prediction(pred: Decomposition, batch: Batch, config: RunConfig) -> Decomposition:
-    """The prediction, detached, with its albedo replaced by the batch's images divided by its shading
-    (render.scene.divide_shading, the true silhouette as the coverage): what the cycles redraw with under
-    loss.cycle_albedo = "divided"."""
+def divided_prediction(pred: Decomposition, shading: Shading, batch: Batch, config: RunConfig) -> Decomposition:
+    """The prediction, detached, with its albedo replaced by the batch's images divided by its shading (`shading`,
+    already computed by render_prediction; render.scene.divide_shading, the true silhouette as the coverage): what
+    the cycles redraw with under loss.cycle_albedo = "divided"."""
     m = config.model
     target = pred.detach()
-    albedo = divide_shading(batch.image, *target.as_tuple(), m.render, m.camera, batch.mask[:, None])
+    albedo = divide_shading(batch.image, target.radius, target.height, target.pose, target.albedo, target.rho,
+                            shading, m.render, m.camera, batch.mask[:, None])
     return dataclasses.replace(target, albedo=albedo)
 
 
@@ -228,7 +229,7 @@ def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig, disc:
         if model is None:
             raise ValueError("loss.cycle_weight or loss.light_cycle_weight > 0 needs the model")
         background = background_colour(batch.image, batch.mask)
-        drawn = divided_prediction(pred, batch, config) if lc.cycle_albedo == "divided" else pred
+        drawn = divided_prediction(pred, shading, batch, config) if lc.cycle_albedo == "divided" else pred
     if lc.cycle_weight > 0:
         terms["cycle"] = shape_cycle_term(model.shape_net, drawn, background, config)
         total = total + lc.cycle_weight * terms["cycle"]

@@ -66,7 +66,9 @@ def test_albedo_sources(tmp_path: Path) -> None:
     # texels that unwrap from off the object keep the network's albedo; no silhouette counts as all object
     predictor = Predictor.from_checkpoint(path, "cpu")
     off = predictor.predict(images, [np.zeros((32, 32), bool), None])
-    assert torch.allclose(off.albedo[0], network.albedo[0]) and torch.allclose(off.albedo[1], divided.albedo[1])
+    # (to float rounding: a bilinear sample of an all-ones silhouette can come out 1 - 6e-8)
+    assert torch.allclose(off.albedo[0], network.albedo[0], atol=1e-6)
+    assert torch.allclose(off.albedo[1], divided.albedo[1], atol=1e-6)
     with pytest.raises(InputError, match="silhouettes"):
         predictor.predict(images, [np.ones((16, 16), bool), None])
     with pytest.raises(InputError, match="albedo source"):

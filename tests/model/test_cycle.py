@@ -18,7 +18,7 @@ from radar_cli.render.lighting import tone_map
 from radar_cli.render.texture import full_from_front
 from radar_cli.synth.render import render_sample
 from radar_cli.train.step import (Batch, background_colour, divided_prediction, generator_losses, light_cycle_term,
-                                  redraw, relit)
+                                  redraw, relit, render_prediction)
 
 from .conftest import box_batch, tiny_config
 
@@ -188,14 +188,15 @@ def test_cycles_can_redraw_with_the_divided_albedo():
     (detached, in [0, 1], f_A's albedo kept where the true silhouette is off), and train the same networks."""
     config, model, batch = _model_and_batch(cycle_weight=1.0, light_cycle_weight=1.0, cycle_albedo="divided")
     pred = model(batch.image)
-    divided = divided_prediction(pred, batch, config)
+    _, shading, _, _ = render_prediction(pred, config)
+    divided = divided_prediction(pred, shading, batch, config)
     assert not divided.albedo.requires_grad and divided.albedo.shape == pred.albedo.shape
     assert 0 <= divided.albedo.min() and divided.albedo.max() <= 1
     assert not torch.allclose(divided.albedo, pred.albedo.detach())
     for kept in ("radius", "height", "pose", "env", "alpha", "rho"):
         assert torch.equal(getattr(divided, kept), getattr(pred, kept).detach())
     off = Batch(batch.image, torch.zeros_like(batch.mask), batch.dt)
-    assert torch.allclose(divided_prediction(pred, off, config).albedo, pred.albedo.detach())
+    assert torch.allclose(divided_prediction(pred, shading, off, config).albedo, pred.albedo.detach())
     torch.manual_seed(2)
     terms, _ = generator_losses(pred, batch, config, None, model)
     torch.manual_seed(2)
