@@ -17,6 +17,8 @@ TRAIN_ARGS ?=
 # the albedo the evaluation targets score: the paper's Table 2 scores the albedo network's output (network);
 # ALBEDO=divided scores `radar derender`'s default, the input divided by the predicted shading
 ALBEDO ?= network
+# PITCH=search scores `radar derender --pitch search` (the test-time pitch search) instead of f_S's pitch
+PITCH ?= network
 
 .PHONY: install demo test test-all test-gpu clean \
         syn-data syn-data-cpu train-syn train-syn-cpu eval-syn eval-syn-cpu table2 table2-cpu \
@@ -59,7 +61,7 @@ train-syn: $(STAMP)
 
 eval-syn: $(STAMP)
 	$(RADAR) derender data/syn_vases/test --checkpoint runs/syn_vases/model.safetensors --out results/syn_vases \
-		--views 0 --device $(DEVICE) --workers $(WORKERS) --albedo $(ALBEDO)
+		--views 0 --device $(DEVICE) --workers $(WORKERS) --albedo $(ALBEDO) --pitch $(PITCH)
 	$(RADAR) eval --pred results/syn_vases --gt data/syn_vases --json results/syn_vases/eval.json
 
 # Every row of Table 2: the full model, the ablations and the supervised upper bound.
@@ -67,7 +69,7 @@ table2: $(STAMP)
 	for p in syn_vases syn_vases_no_alb syn_vases_no_sad syn_vases_no_diff syn_vases_supervised; do \
 		$(RADAR) train --config pipelines/$$p.toml --data data/syn_vases --out runs/$$p --device $(DEVICE) && \
 		$(RADAR) derender data/syn_vases/test --checkpoint runs/$$p/model.safetensors --out results/$$p \
-			--views 0 --device $(DEVICE) --workers $(WORKERS) --albedo $(ALBEDO) && \
+			--views 0 --device $(DEVICE) --workers $(WORKERS) --albedo $(ALBEDO) --pitch $(PITCH) && \
 		$(RADAR) eval --pred results/$$p --gt data/syn_vases --json results/$$p/eval.json || exit 1; \
 	done
 
@@ -103,14 +105,14 @@ train-syn-cpu: $(STAMP)
 
 eval-syn-cpu: $(STAMP)
 	$(RADAR) derender data/syn_cpu/test --checkpoint runs/syn_cpu_divided/model.safetensors --out results/syn_cpu \
-		--views 0 --albedo $(ALBEDO)
+		--views 0 --albedo $(ALBEDO) --pitch $(PITCH)
 	$(RADAR) eval --pred results/syn_cpu --gt data/syn_cpu --json results/syn_cpu/eval.json
 
 table2-cpu: $(STAMP)
 	for p in syn_vases_cpu syn_vases_cpu_no_alb syn_vases_cpu_no_sad syn_vases_cpu_no_diff syn_vases_cpu_supervised; do \
 		$(RADAR) train --config pipelines/$$p.toml --data data/syn_cpu --out runs/$$p --device cpu $(TRAIN_THREADS) && \
 		$(RADAR) derender data/syn_cpu/test --checkpoint runs/$$p/model.safetensors --out results/$$p --views 0 \
-			--albedo $(ALBEDO) && \
+			--albedo $(ALBEDO) --pitch $(PITCH) && \
 		$(RADAR) eval --pred results/$$p --gt data/syn_cpu --json results/$$p/eval.json || exit 1; \
 	done
 

@@ -90,11 +90,13 @@ def synth(size: int, n: int, workers: int, shading_size: int) -> None:
               help="Threads cropping and exporting objects (radar derender --workers).")
 @click.option("--albedo", type=click.Choice(["network", "divided"]), default="divided", show_default=True,
               help="radar derender --albedo.")
+@click.option("--pitch", type=click.Choice(["network", "search"]), default="network", show_default=True,
+              help="radar derender --pitch.")
 def derender(checkpoint: str | None, device: str, images: int, exports: int, batch_size: int, threads: int,
-             workers: int, albedo: str) -> None:
+             workers: int, albedo: str, pitch: str) -> None:
     """Images per second for the network alone and for the full de-rendering with all exports."""
     from radar_cli.derender.benchmark import bench_derender
 
     click.echo(json.dumps(bench_derender(checkpoint, device, images, exports, batch_size, threads, workers=workers,
-                                         albedo=albedo),  # type: ignore[arg-type]
+                                         albedo=albedo, pitch=pitch),  # type: ignore[arg-type]
                           indent=2))

@@ -10,7 +10,7 @@ import click
 from radar_cli.derender.batch import DerenderOptions, derender as run_derender
 from radar_cli.derender.contact_sheet import contact_sheet as write_contact_sheet
 from radar_cli.derender.export import ExportConfig
-from radar_cli.derender.predictor import ALBEDO_SOURCES, Predictor
+from radar_cli.derender.predictor import ALBEDO_SOURCES, PITCH_SOURCES, Predictor
 
 
 @click.command("derender")
@@ -31,6 +31,9 @@ from radar_cli.derender.predictor import ALBEDO_SOURCES, Predictor
 @click.option("--albedo", type=click.Choice(ALBEDO_SOURCES), default="divided", show_default=True,
               help="divided: the photo's texture divided by the predicted shading (keeps painted detail); "
                    "network: the albedo network's output, as the paper.")
+@click.option("--pitch", type=click.Choice(PITCH_SOURCES), default="network", show_default=True,
+              help="network: the shape network's pitch; search: the pitch whose re-rendering best matches the "
+                   "photo and its silhouette, searched over the range (slower).")
 @click.option("--views", type=click.IntRange(0, 360), default=8, show_default=True, help="Turntable frames.")
 @click.option("--view-size", type=click.IntRange(16, 1024), default=128, show_default=True,
               help="Side in pixels of turntable frames, relit views and the material sphere.")
@@ -45,10 +48,10 @@ from radar_cli.derender.predictor import ALBEDO_SOURCES, Predictor
 @click.option("--contact-sheet", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Also write a contact sheet PNG (input, reconstruction, albedo, relit view per object).")
 def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks: Path | None, crop: str,
-             backdrop: str, device: str, albedo: str, views: int, view_size: int, envs: tuple[Path, ...],
+             backdrop: str, device: str, albedo: str, pitch: str, views: int, view_size: int, envs: tuple[Path, ...],
              batch_size: int, workers: int, threads: int, overwrite: bool, contact_sheet: Path | None) -> None:
     """De-render INPUTS (image files, folders, prepared dataset folders) into --out."""
-    predictor = Predictor.from_checkpoint(checkpoint, device, albedo)  # type: ignore[arg-type]
+    predictor = Predictor.from_checkpoint(checkpoint, device, albedo, pitch)  # type: ignore[arg-type]
     options = DerenderOptions(out=out, crop=crop, backdrop=backdrop, masks=masks,  # type: ignore[arg-type]
                               envs=envs, batch_size=batch_size, workers=workers, threads=threads, overwrite=overwrite,
                               export=ExportConfig(views, view_size))

@@ -179,7 +179,7 @@ def _export_all(ok: list[tuple[InputItem, Prepared]], dec: Decomposition, predic
         item, prep = ok[k]
         try:
             export_object(options.out / item.name, item, prep, dec.select(k), predictor.setup,
-                          predictor.version, envs, options.export, predictor.albedo)
+                          predictor.version, envs, options.export, predictor.albedo, predictor.pitch)
         except ITEM_ERRORS as e:
             return Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
         return None

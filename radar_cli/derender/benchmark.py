@@ -12,7 +12,7 @@ import torch
 
 from radar_cli.derender.batch import DerenderOptions, derender, torch_threads
 from radar_cli.derender.export import ExportConfig
-from radar_cli.derender.predictor import AlbedoSource, Predictor
+from radar_cli.derender.predictor import AlbedoSource, PitchSource, Predictor
 from radar_cli.fileio import write_image
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -40,12 +40,19 @@ def _photos(n: int, size: int, seed: int = 0) -> list[np.ndarray]:
     return photos
 
 
+def _silhouettes(images: list[np.ndarray]) -> list[np.ndarray]:
+    """H x W bool masks: the pixels that differ from the image's corner (the plain backdrop) by > 12 levels."""
+    return [np.abs(im.astype(np.int16) - im[0, 0].astype(np.int16)).max(axis=-1) > 12 for im in images]
+
+
 def _network_rate(predictor: Predictor, images: list[np.ndarray], batch_size: int) -> tuple[float, float]:
-    """(images/s wall, images/s of process CPU time) of predictor.predict, after one warm-up batch."""
-    predictor.predict(images[:batch_size])
+    """(images/s wall, images/s of process CPU time) of predictor.predict with the images' silhouettes, after
+    one warm-up batch."""
+    masks = _silhouettes(images)
+    predictor.predict(images[:batch_size], masks[:batch_size])
     wall, cpu = time.perf_counter(), time.process_time()
     for i in range(0, len(images), batch_size):
-        predictor.predict(images[i : i + batch_size])
+        predictor.predict(images[i : i + batch_size], masks[i : i + batch_size])
     if predictor.device.type == "cuda":
         torch.cuda.synchronize()
     return len(images) / (time.perf_counter() - wall), len(images) / max(time.process_time() - cpu, 1e-9)
@@ -54,7 +61,8 @@ def _network_rate(predictor: Predictor, images: list[np.ndarray], batch_size: in
 def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_images: int = 32,
                    n_export: int = 4, batch_size: int = 8, threads: int = 1,
                    export: ExportConfig = ExportConfig(), predictor: Predictor | None = None,
-                   workers: int = 2, albedo: AlbedoSource = "divided") -> dict:
+                   workers: int = 2, albedo: AlbedoSource = "divided",
+                   pitch: PitchSource = "network") -> dict:
     """Measure de-rendering speed.
 
     Args:
@@ -68,12 +76,14 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         predictor: use this instead of loading `checkpoint` (tests).
         workers: threads cropping and exporting objects.
         albedo: the predictor's albedo source (`divided` adds the shading division to the network's time).
+        pitch: the predictor's pitch source (`search` adds the pitch search).
 
     Returns:
         {"network_images_per_s", "network_images_per_cpu_s", "full_images_per_s", "full_seconds_per_image",
-         "image_size", "batch_size", "n_images", "n_export", "device", "threads", "workers", "albedo", "model"}.
+         "image_size", "batch_size", "n_images", "n_export", "device", "threads", "workers", "albedo", "pitch",
+         "model"}.
     """
-    predictor = predictor or Predictor.from_checkpoint(checkpoint, device, albedo)
+    predictor = predictor or Predictor.from_checkpoint(checkpoint, device, albedo, pitch)
     size = predictor.setup.image_size
     images = _photos(n_images, size)
     with torch_threads(threads):
@@ -100,5 +110,6 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         "threads": threads,
         "workers": workers,
         "albedo": predictor.albedo,
+        "pitch": predictor.pitch,
         "model": predictor.version,
     }

@@ -11,7 +11,7 @@ import numpy as np
 from radar_cli.derender.inputs import InputItem, Prepared
 from radar_cli.derender.maps import write_maps
 from radar_cli.derender.mesh import write_meshes
-from radar_cli.derender.predictor import AlbedoSource, ModelSetup
+from radar_cli.derender.predictor import AlbedoSource, ModelSetup, PitchSource
 from radar_cli.derender.renders import write_renders
 from radar_cli.derender.state import ObjectState
 from radar_cli.fileio import write_image, write_json
@@ -36,7 +36,7 @@ def is_complete(folder: Path) -> bool:
 
 def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomposition, setup: ModelSetup,
                   version: str, envs: dict[str, np.ndarray], config: ExportConfig = ExportConfig(),
-                  albedo_source: AlbedoSource = "network") -> dict:
+                  albedo_source: AlbedoSource = "network", pitch_source: PitchSource = "network") -> dict:
     """Write all files of one object.
 
     Args:
@@ -48,6 +48,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomp
         envs: relighting environments by name (He x We each).
         config: turntable and view settings.
         albedo_source: where the albedo came from (`network` or `divided`, see Predictor).
+        pitch_source: where the pitch came from (`network` or `search`, see Predictor).
 
     Returns:
         The material.json record.
@@ -68,6 +69,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomp
         "image_size": setup.image_size,
         "model": version,
         "albedo_source": albedo_source,
+        "pitch_source": pitch_source,
         "environments": sorted(envs),
     })
     write_json(folder / MATERIAL_FILE, record)

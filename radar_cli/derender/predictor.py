@@ -13,13 +13,17 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig
+from radar_cli.derender.pitch_search import search_pitch
 from radar_cli.errors import CheckpointError, InputError
 from radar_cli.model.outputs import Decomposition
+from radar_cli.model.radar import RadarModel
 from radar_cli.render.scene import divide_shading, shade
 
 ASSETS = Path(__file__).resolve().parents[1] / "assets"
 AlbedoSource = Literal["network", "divided"]
 ALBEDO_SOURCES: tuple[AlbedoSource, ...] = ("network", "divided")
+PitchSource = Literal["network", "search"]
+PITCH_SOURCES: tuple[PitchSource, ...] = ("network", "search")
 
 
 def bundled_checkpoint() -> Path:
@@ -67,21 +71,29 @@ class Predictor:
         albedo: `divided`: the input's texture divided by the predicted shading (render.scene.divide_shading;
             README, Accuracy: albedo si-MSE 4.01 -> 2.33 x 1e-2 with the bundled stage-6 model); `network`: f_A's
             albedo, as the paper.
+        pitch: `network`: f_S's pitch; `search`: derender.pitch_search where the silhouette is known (needs a
+            RadarModel), f_S's elsewhere.
     """
 
     def __init__(self, model: Callable[[torch.Tensor], Decomposition], setup: ModelSetup, version: str,
-                 device: torch.device | str = "cpu", albedo: AlbedoSource = "divided"):
+                 device: torch.device | str = "cpu", albedo: AlbedoSource = "divided",
+                 pitch: PitchSource = "network"):
         if albedo not in ALBEDO_SOURCES:
             raise InputError(f"unknown albedo source {albedo!r} (use {' or '.join(ALBEDO_SOURCES)})")
+        if pitch not in PITCH_SOURCES:
+            raise InputError(f"unknown pitch source {pitch!r} (use {' or '.join(PITCH_SOURCES)})")
+        if pitch == "search" and not isinstance(model, RadarModel):
+            raise InputError("the pitch search needs a RadarModel (a checkpoint), not another callable")
         self.model = model
         self.setup = setup
         self.version = version
         self.device = torch.device(device)
         self.albedo = albedo
+        self.pitch = pitch
 
     @classmethod
     def from_checkpoint(cls, path: str | Path | None = None, device: str = "auto",
-                        albedo: AlbedoSource = "divided") -> "Predictor":
+                        albedo: AlbedoSource = "divided", pitch: PitchSource = "network") -> "Predictor":
         """Load a checkpoint (default: the bundled model); CheckpointError if it is missing or does not fit."""
         path = Path(path) if path is not None else bundled_checkpoint()
         if not path.is_file():
@@ -95,7 +107,7 @@ class Predictor:
         model.eval()
         cfg = model.config
         setup = ModelSetup(cfg.render, cfg.camera, cfg.geometry)
-        return cls(model, setup, f"{path.name}#{_short_hash(path)}", dev, albedo)
+        return cls(model, setup, f"{path.name}#{_short_hash(path)}", dev, albedo, pitch)
 
     @torch.no_grad()
     def predict(self, images: list[np.ndarray],
@@ -105,7 +117,8 @@ class Predictor:
         Args:
             images: S x S x 3 uint8 RGB crops, S = setup.image_size.
             silhouettes: per crop, its S x S bool object mask or None; the divided albedo keeps the network's
-                where the predicted surface unwraps from off the object.
+                where the predicted surface unwraps from off the object, and the pitch search runs where it is
+                known.
 
         Returns:
             Decomposition of the batch, on the CPU, detached.
@@ -117,6 +130,8 @@ class Predictor:
         batch = torch.from_numpy(np.stack(images)).permute(0, 3, 1, 2)  # B x 3 x S x S uint8
         batch = batch.to(self.device, torch.float32) / 255.0
         dec = self.model(batch)
+        if self.pitch == "search" and silhouettes is not None:
+            dec = self._search_pitch(batch, silhouettes, dec)
         if self.albedo == "divided":
             coverage = None if silhouettes is None else _coverage(silhouettes, size).to(self.device)
             render, camera = self.setup.render, self.setup.camera
@@ -125,6 +140,17 @@ class Predictor:
                                     camera, coverage)
             dec = dataclasses.replace(dec, albedo=albedo)
         return dec.detach().to("cpu")
+
+    def _search_pitch(self, batch: torch.Tensor, silhouettes: list[np.ndarray | None],
+                      dec: Decomposition) -> Decomposition:
+        """`dec` with the searched pitch (and f_L, f_A re-read there) for the crops whose silhouette is known."""
+        known = [i for i, m in enumerate(silhouettes) if m is not None]
+        if not known:
+            return dec
+        index = torch.tensor(known, device=self.device)
+        part = Decomposition(*(t.index_select(0, index) for t in dec.as_tuple()))
+        found = search_pitch(self.model, batch.index_select(0, index), [silhouettes[i] for i in known], part)
+        return Decomposition(*(t.index_copy(0, index, f) for t, f in zip(dec.as_tuple(), found.as_tuple())))
 
 
 def _coverage(silhouettes: list[np.ndarray | None], size: int) -> torch.Tensor:

@@ -33,7 +33,7 @@ def distance_transform(mask: np.ndarray) -> np.ndarray:
 
 
 def silhouette_loss(sil: torch.Tensor, target: torch.Tensor, dt: torch.Tensor, w_mse: float,
-                    w_dt: float, margin_px: float = 0.0) -> torch.Tensor:
+                    w_dt: float, margin_px: float = 0.0, per_sample: bool = False) -> torch.Tensor:
     """L_sil = w_mse * MSE(S, S^) + w_dt * mean(max(0, dt(S) - margin) * S^) (Eq. 3; margin 0 in the paper).
 
     Args:
@@ -41,20 +41,25 @@ def silhouette_loss(sil: torch.Tensor, target: torch.Tensor, dt: torch.Tensor, w
         target: B x H x W target silhouette (0/1 float).
         dt: B x H x W distance transform of the target (image sides).
         margin_px: distance from the target, in pixels, within which the predicted silhouette is not penalised.
+        per_sample: return the B values (each over its own pixels) instead of the batch's mean.
     """
     if margin_px > 0:
         dt = (dt - margin_px / dt.shape[-1]).clamp_min(0.0)
-    return w_mse * ((sil - target) ** 2).mean() + w_dt * (dt * sil).mean()
+    dims = (1, 2) if per_sample else None
+    return w_mse * ((sil - target) ** 2).mean(dims) + w_dt * (dt * sil).mean(dims)
 
 
-def masked_l1(pred: torch.Tensor, target: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:
+def masked_l1(pred: torch.Tensor, target: torch.Tensor, weight: torch.Tensor,
+              per_sample: bool = False) -> torch.Tensor:
     """Mean absolute error over the pixels where weight > 0 (L_im, Eq. 10, and L_alb, Eq. 11).
 
     Args:
         pred, target: B x C x H x W. weight: B x 1 x H x W in [0, 1] (S~ = S and S^_f).
+        per_sample: return the B values (each over its own weighted pixels) instead of the batch's.
     """
-    total = (weight.sum() * pred.shape[1]).clamp_min(1.0)
-    return ((pred - target).abs() * weight).sum() / total
+    dims = (1, 2, 3) if per_sample else None
+    total = (weight.sum(dims) * pred.shape[1]).clamp_min(1.0)
+    return ((pred - target).abs() * weight).sum(dims) / total
 
 
 def mouth_l1(recon_mu: torch.Tensor, front: torch.Tensor, mouth: torch.Tensor, image: torch.Tensor,

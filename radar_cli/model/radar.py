@@ -57,7 +57,16 @@ class RadarModel(nn.Module):
         """
         size = self.config.render.image_size
         check_shape(image, f"B 3 {size} {size}", "image")
-        radius, height, pose = self.shape_net(image)
+        return self.read_appearance(image, *self.shape_net(image))
+
+    def read_appearance(self, image: torch.Tensor, radius: torch.Tensor, height: torch.Tensor,
+                        pose: torch.Tensor) -> Decomposition:
+        """f_L and f_A on the texture unwrapped from `image` with the given shape and pose (f_S's, or another
+        pose under test, derender.pitch_search).
+
+        Args:
+            image: B x 3 x H x W. radius: B x L; height: B; pose: B x 4.
+        """
         geo = (radius, height, pose)
         if self.config.detach_shape_for_texture:
             geo = tuple(t.detach() for t in geo)

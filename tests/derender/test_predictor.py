@@ -89,6 +89,11 @@ def test_cli_with_a_real_checkpoint(tmp_path: Path) -> None:
                                       "--checkpoint", str(path), "--views", "0", "--albedo", "network"])
     assert result.exit_code == 0, result.output
     assert json.loads((tmp_path / "net" / "a" / "material.json").read_text())["albedo_source"] == "network"
+    assert material["pitch_source"] == "network"
+    result = CliRunner().invoke(cli, ["derender", str(tmp_path / "in"), "--out", str(tmp_path / "search"),
+                                      "--checkpoint", str(path), "--views", "0", "--pitch", "search"])
+    assert result.exit_code == 0, result.output
+    assert json.loads((tmp_path / "search" / "a" / "material.json").read_text())["pitch_source"] == "search"
 
 
 def test_checkpoint_from_another_config_is_one_clear_error(tmp_path: Path) -> None:

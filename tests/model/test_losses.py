@@ -44,6 +44,24 @@ def test_reference_values():
     assert torch.allclose(L.mean_color(albedo), albedo.mean(dim=(2, 3), keepdim=True).expand_as(albedo))
 
 
+def test_per_sample_terms_score_each_sample_alone():
+    """per_sample=True gives each sample the value a batch of one would (the pitch search ranks them so)."""
+    g = torch.Generator().manual_seed(0)
+    sil, target = torch.rand(3, 8, 8, generator=g), (torch.rand(3, 8, 8, generator=g) > 0.5).float()
+    dt = torch.rand(3, 8, 8, generator=g)
+    pred, image = torch.rand(3, 3, 8, 8, generator=g), torch.rand(3, 3, 8, 8, generator=g)
+    weight = torch.rand(3, 1, 8, 8, generator=g) * (torch.arange(3) > 0).view(3, 1, 1, 1)  # one empty weight
+    sil_each = L.silhouette_loss(sil, target, dt, 10.0, 100.0, 1.0, per_sample=True)
+    l1_each = L.masked_l1(pred, image, weight, per_sample=True)
+    assert sil_each.shape == l1_each.shape == (3,) and l1_each[0] == 0
+    for i in range(3):
+        one = slice(i, i + 1)
+        assert sil_each[i].item() == pytest.approx(L.silhouette_loss(sil[one], target[one], dt[one], 10.0, 100.0,
+                                                                     1.0).item(), rel=1e-6)
+        assert l1_each[i].item() == pytest.approx(L.masked_l1(pred[one], image[one], weight[one]).item(), rel=1e-6)
+    assert sil_each.mean().item() == pytest.approx(L.silhouette_loss(sil, target, dt, 10.0, 100.0, 1.0).item())
+
+
 def test_patches_split_by_specular_variance():
     torch.manual_seed(0)
     albedo = torch.rand(2, 3, 32, 32)
