@@ -127,13 +127,13 @@ class Predictor:
         for im in images:
             if im.shape != (size, size, 3) or im.dtype != np.uint8:
                 raise InputError(f"expected {size} x {size} x 3 uint8 crops, got {im.shape} {im.dtype}")
+        coverage = None if silhouettes is None else _coverage(silhouettes, size).to(self.device)  # checks them
         batch = torch.from_numpy(np.stack(images)).permute(0, 3, 1, 2)  # B x 3 x S x S uint8
         batch = batch.to(self.device, torch.float32) / 255.0
         dec = self.model(batch)
         if self.pitch == "search" and silhouettes is not None:
             dec = self._search_pitch(batch, silhouettes, dec)
         if self.albedo == "divided":
-            coverage = None if silhouettes is None else _coverage(silhouettes, size).to(self.device)
             render, camera = self.setup.render, self.setup.camera
             shading = shade(*dec.as_tuple(), render, camera)
             albedo = divide_shading(batch, dec.radius, dec.height, dec.pose, dec.albedo, dec.rho, shading, render,

@@ -82,6 +82,8 @@ def test_predictor_searches_only_where_the_silhouette_is_known(tmp_path: Path) -
     assert moved, "the search kept f_S's pitch on both objects"
     for i in moved:
         assert not torch.equal(searched.albedo[i], network.albedo[i])
+    with pytest.raises(InputError, match="silhouettes"):
+        Predictor.from_checkpoint(path, "cpu", pitch="search").predict(images, [np.ones((16, 16), bool)] * 3)
     # no silhouettes at all: f_S's pitch
     assert torch.equal(Predictor.from_checkpoint(path, "cpu", albedo="network", pitch="search").predict(images).pose,
                        network.pose)
