@@ -19,8 +19,7 @@ from radar_cli.model import losses as L
 from radar_cli.model.outputs import Decomposition
 from radar_cli.model.radar import RadarModel
 from radar_cli.render.lighting import compose
-from radar_cli.render.raycast import cast_rays
-from radar_cli.render.scene import render_front, shade
+from radar_cli.render.scene import render_front, render_frontal
 
 
 @dataclass(frozen=True)
@@ -62,9 +61,7 @@ def score(model: RadarModel, image: torch.Tensor, mask: torch.Tensor, dt: torch.
     pose = first.pose.clone()
     pose[:, 0] = pitch
     pred = model.read_appearance(image, first.radius, first.height, pose)
-    hits = cast_rays(pred.radius, pred.height, pose, c.render.image_size, c.camera, c.render.sil_sigma_px)
-    shading = shade(*pred.as_tuple(), c.render, c.camera)
-    recon, front = render_front(hits, shading.texture)
+    hits, shading, recon, front = render_frontal(*pred.as_tuple(), c.render, c.camera)
     tex_mu = compose(L.mean_color(pred.albedo), shading.diffuse, shading.specular, pred.rho, c.render.gamma)
     recon_mu, _ = render_front(hits, tex_mu)
     weight = mask[:, None] * front  # B x 1 x H x W

@@ -103,6 +103,31 @@ def render_front(hits: Hits, texture: torch.Tensor, background: float = 0.0) -> 
     return render_texture(hits, texture, front_only=True, background=background)
 
 
+def render_frontal(
+    radius: torch.Tensor,
+    height: torch.Tensor,
+    pose: torch.Tensor,
+    albedo: torch.Tensor,
+    env: torch.Tensor,
+    alpha: torch.Tensor,
+    rho: torch.Tensor,
+    render: RenderConfig,
+    camera: CameraConfig,
+) -> tuple[Hits, Shading, torch.Tensor, torch.Tensor]:
+    """A prediction drawn as the training's losses see it: ray-cast, shade the frontal third, render it.
+
+    Args:
+        radius: B x L; height: B; pose: B x 4. albedo: B x 3 x Ht x Wt frontal, linear. env: B x He x We.
+
+    Returns:
+        (hits, shading, I^ B x 3 x H x W, S^_f B x 1 x H x W).
+    """
+    hits = cast_rays(radius, height, pose, render.image_size, camera, render.sil_sigma_px)
+    shading = shade(radius, height, pose, albedo, env, alpha, rho, render, camera)
+    recon, front = render_front(hits, shading.texture)
+    return hits, shading, recon, front
+
+
 MAX_SPECULAR_SHARE = 0.8
 """divide_shading's cap on the share of a texel's radiance taken as highlight; chosen with the bundled model on 460
 training vases among 0.5-1.0 (albedo si-MSE x 1e-2: 0.5 2.65, 0.7 2.42, 0.8 2.40, 0.9 2.45, 1.0 2.84; f_A 3.77)."""

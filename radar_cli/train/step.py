@@ -17,8 +17,8 @@ from radar_cli.model.outputs import Decomposition
 from radar_cli.model.radar import RadarModel
 from radar_cli.render.lighting import compose, tone_map
 from radar_cli.render.mouth import coverage, coverage_above, mouth_margin
-from radar_cli.render.raycast import Hits, cast_rays
-from radar_cli.render.scene import Shading, divide_shading, render_front, render_synthetic, shade
+from radar_cli.render.raycast import Hits
+from radar_cli.render.scene import Shading, divide_shading, render_front, render_frontal, render_synthetic
 from radar_cli.render.texture import full_from_front
 
 
@@ -68,12 +68,7 @@ def output_ranges(config: RunConfig) -> dict[str, tuple[float, float]]:
 
 def render_prediction(pred: Decomposition, config: RunConfig) -> tuple[Hits, Shading, torch.Tensor, torch.Tensor]:
     """Ray-cast, shade and render the frontal third of a prediction: (hits, shading, I^, S^_f)."""
-    m = config.model
-    hits = cast_rays(pred.radius, pred.height, pred.pose, m.render.image_size, m.camera, m.render.sil_sigma_px)
-    shading = shade(pred.radius, pred.height, pred.pose, pred.albedo, pred.env, pred.alpha, pred.rho,
-                    m.render, m.camera)
-    recon, front = render_front(hits, shading.texture)
-    return hits, shading, recon, front
+    return render_frontal(*pred.as_tuple(), config.model.render, config.model.camera)
 
 
 def _mouth_term(pred: Decomposition, hits: Hits, recon_mu: torch.Tensor, front: torch.Tensor, batch: Batch,
