@@ -33,6 +33,8 @@ class PitchSearch:
         sil_weight, dt_weight, dt_margin_px: L_sil as in training (Eq. 3 with the sharp stages' margin).
         im_weight, alb_weight: L_im and L_alb (mean-colour albedo) on the true and rendered frontal masks.
         prior_weight: per squared degree away from f_S's pitch.
+        max_pixels: image pixels redrawn in one pass (samples x candidates x H x W), bounding its memory: 64
+            redraws at 64 px, 4 at 256 px (but always one sample's whole grid).
     """
 
     coarse_step: float = 4.0
@@ -44,6 +46,7 @@ class PitchSearch:
     im_weight: float = 1.0
     alb_weight: float = 2.0
     prior_weight: float = 3e-4
+    max_pixels: int = 64 * 64 * 64
 
 
 def score(model: RadarModel, image: torch.Tensor, mask: torch.Tensor, dt: torch.Tensor, first: Decomposition,
@@ -74,10 +77,24 @@ def score(model: RadarModel, image: torch.Tensor, mask: torch.Tensor, dt: torch.
 
 def _grid_scores(model: RadarModel, image: torch.Tensor, mask: torch.Tensor, dt: torch.Tensor,
                  first: Decomposition, candidates: torch.Tensor, search: PitchSearch) -> torch.Tensor:
-    """B x G scores of the candidate pitches B x G (each clamped to the model's range)."""
+    """B x G scores of the candidate pitches B x G (each clamped to the model's range).
+
+    The candidates are scored as one batch of B * G redraws (each sample repeated G times), at most
+    `search.max_pixels` at a time: one pass per chunk instead of one per candidate.
+    """
     lo, hi = model.config.geometry.pitch_range
-    return torch.stack([score(model, image, mask, dt, first, candidates[:, j].clamp(lo, hi), search)
-                        for j in range(candidates.shape[1])], dim=1)
+    batch, grid = candidates.shape
+    per_call = max(1, search.max_pixels // (grid * image.shape[-2] * image.shape[-1]))
+    chunks = []
+    for start in range(0, batch, per_call):
+        part = slice(start, start + per_call)
+        # each of the chunk's n samples repeated G times, candidate-minor: (n * G) x ...
+        image_g, mask_g, dt_g, *first_g = (t[part].repeat_interleave(grid, dim=0)
+                                           for t in (image, mask, dt, *first.as_tuple()))
+        pitch = candidates[part].clamp(lo, hi).reshape(-1)  # (n * G)
+        scores = score(model, image_g, mask_g, dt_g, Decomposition(*first_g), pitch, search)
+        chunks.append(scores.view(-1, grid))
+    return torch.cat(chunks)
 
 
 def parabola_vertex(scores: torch.Tensor, step: float) -> torch.Tensor:

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 import torch
 
-from radar_cli.derender.pitch_search import PitchSearch, parabola_vertex, search_pitch
+from radar_cli.derender.pitch_search import PitchSearch, _grid_scores, parabola_vertex, score, search_pitch
+from radar_cli.model.losses import distance_transform
 from radar_cli.derender.predictor import ASSETS, Predictor
 from radar_cli.errors import InputError
 
@@ -87,6 +88,30 @@ def test_predictor_searches_only_where_the_silhouette_is_known(tmp_path: Path) -
     # no silhouettes at all: f_S's pitch
     assert torch.equal(Predictor.from_checkpoint(path, "cpu", albedo="network", pitch="search").predict(images).pose,
                        network.pose)
+
+
+def test_grid_scores_in_chunks_equal_one_redraw_per_candidate(tmp_path: Path) -> None:
+    """The candidates are redrawn as one batch, cut into chunks by `max_pixels`: every chunking (a sample at a
+    time, two, all five) gives each candidate the score it gets redrawn alone."""
+    model = Predictor.from_checkpoint(save_weights(tmp_path / "tiny.safetensors", tiny_config()), "cpu").model
+    torch.manual_seed(0)
+    image = torch.rand(5, 3, 32, 32)
+    masks = [np.hypot(*np.mgrid[-16:16, -16:16]) < r for r in (6, 8, 10, 12, 14)]
+    mask = torch.from_numpy(np.stack(masks).astype(np.float32))  # 5 x 32 x 32
+    dt = torch.from_numpy(np.stack([distance_transform(m) for m in masks]))
+    candidates = torch.tensor([[0.0, 4.0, 8.0], [3.0, 11.0, 30.0], [1.5, 2.5, 19.0], [7.0, 7.0, 9.0],
+                               [-5.0, 12.0, 16.0]])  # 5 x 3, two outside the range (clamped)
+    with torch.no_grad():
+        first = model(image)
+        lo, hi = model.config.geometry.pitch_range
+        alone = torch.stack([score(model, image, mask, dt, first, candidates[:, j].clamp(lo, hi), PitchSearch())
+                             for j in range(3)], dim=1)
+        for samples_per_pass in (1, 2, 5):
+            chunked = PitchSearch(max_pixels=samples_per_pass * 3 * 32 * 32)
+            got = _grid_scores(model, image, mask, dt, first, candidates, chunked)
+            assert got.shape == (5, 3)
+            assert torch.allclose(got, alone, rtol=1e-5, atol=1e-6), samples_per_pass
+    assert torch.equal(alone[3, 0], alone[3, 1])  # the same pitch twice scores the same
 
 
 def test_pitch_source_is_checked(tmp_path: Path) -> None:
