@@ -31,14 +31,18 @@ OUT_OF_TIME_STATUS = 3
 @click.option("--max-minutes", type=click.FloatRange(min=0, min_open=True), default=None,
               help="Wall-time budget: past it, write a checkpoint and stop with exit status 3 (continue with "
                    "--resume).")
+@click.option("--pitch-labels", type=click.Path(file_okay=False), default=None,
+              help="`radar derender DATA/train --pitch search` results, for loss.pitch_label_weight "
+                   "(self-training on pitch).")
 def train(config_path: str, data_dir: str, run_dir: str, resume: bool, device: str | None, overfit: int | None,
-          iterations: int | None, init: str | None, threads: int | None, max_minutes: float | None) -> None:
+          iterations: int | None, init: str | None, threads: int | None, max_minutes: float | None,
+          pitch_labels: str | None) -> None:
     """Train the de-rendering model (shape, lighting, albedo networks + SAD discriminator)."""
     from radar_cli.train.trainer import train as run_training
 
     summary = run_training(load_run_config(config_path), data_dir, run_dir, resume=resume, device=device,
                            overfit=overfit, iterations=iterations, init=init, threads=threads,
-                           max_minutes=max_minutes)
+                           max_minutes=max_minutes, pitch_labels=pitch_labels)
     losses = "  ".join(f"{k}={v:.4f}" for k, v in summary.losses.items())
     click.echo(f"trained steps {summary.start}..{summary.end} in {summary.seconds:.1f} s "
                f"({summary.sec_per_step:.3f} s/step)")

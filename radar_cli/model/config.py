@@ -99,6 +99,10 @@ class LossConfig:
     sad_patches_per_image: int = 4
     sad_group_fraction: float = 0.5
     """Fraction of the sorted patches in each group (lowest specular variance = real, highest = fake)."""
+    pitch_label_weight: float = 0.0
+    """Weight of self-training on pitch (radar's addition; 0 = off): L1 of f_S's pitch, over the pitch range,
+    against each training sample's pitch from `radar derender --pitch search` (`radar train --pitch-labels`), so
+    the single-pass network learns what the slower analysis by synthesis finds. No ground truth is used."""
     no_alb: bool = False
     no_sad: bool = False
     no_diff: bool = False
@@ -146,7 +150,7 @@ class RunConfig:
             raise ConfigError(f"loss.sad_patch must be a power of two in [8, texture size], got {p}")
         if self.loss.mouth_weight < 0 or self.loss.mouth_sigma_px <= 0:
             raise ConfigError("loss.mouth_weight must be >= 0 and loss.mouth_sigma_px > 0")
-        for name in ("cycle_weight", "light_cycle_weight"):
+        for name in ("cycle_weight", "light_cycle_weight", "pitch_label_weight"):
             if getattr(self.loss, name) < 0:
                 raise ConfigError(f"loss.{name} must be >= 0, got {getattr(self.loss, name)}")
         if not 0 < self.loss.sad_group_fraction <= 0.5:

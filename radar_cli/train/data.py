@@ -20,8 +20,10 @@ from torch.utils.data import Sampler
 
 from radar_cli.dataset import SampleRef, list_samples, read_sample
 from radar_cli.errors import InputError
+from radar_cli.evaluate.loading import number, read_json
 from radar_cli.model.losses import distance_transform
 from radar_cli.model.outputs import Decomposition
+from radar_cli.results import MATERIAL_FILE
 from radar_cli.synth.layout import ALBEDO_FILE, ENV_MAP_FILE, PARAMS_FILE
 from radar_cli.train.step import Batch
 
@@ -83,6 +85,7 @@ class VaseDataset:
         self.masks = torch.from_numpy(np.stack([s.mask for s in samples]))  # N x S x S bool
         self.dts = torch.from_numpy(np.stack([s.dt for s in samples]))  # N x S x S float32
         self.targets: list[dict | None] = [None] * len(refs)
+        self.pitch_labels: torch.Tensor | None = None  # N degrees, once load_pitch_labels has run
 
     def load_targets(self) -> None:
         """Read params.json of every sample (for the supervised baseline); InputError if one is missing."""
@@ -91,14 +94,31 @@ class VaseDataset:
         if missing:
             raise InputError(f"{missing[0]}: no {PARAMS_FILE} (the supervised baseline needs synthetic ground truth)")
 
+    def load_pitch_labels(self, results_dir: str | Path) -> None:
+        """Read each sample's pitch from `results_dir/<sample id>/material.json`, as `radar derender --pitch
+        search` writes it for a dataset split (loss.pitch_label_weight); InputError names the first sample
+        without a usable one."""
+        labels = []
+        for ref in self.refs:
+            path = Path(results_dir) / ref.sample_id / MATERIAL_FILE
+            if not path.is_file():
+                raise InputError(f"{path}: missing (de-render the training split with `radar derender "
+                                 f"{ref.root / ref.split} --pitch search` into {results_dir})")
+            labels.append(number(read_json(path), "pitch", path))
+        self.pitch_labels = torch.tensor(labels)
+
     def __len__(self) -> int:
         return len(self.refs)
 
     def batch(self, indices: list[int]) -> dict:
-        """{"index": B, "image": B x 3 x S x S uint8, "mask": B x S x S bool, "dt": B x S x S float32}."""
+        """{"index": B, "image": B x 3 x S x S uint8, "mask": B x S x S bool, "dt": B x S x S float32}, and
+        "pitch_label": B degrees when the labels are loaded."""
         idx = torch.as_tensor(indices, dtype=torch.long)
-        return {"index": idx, "image": self.images.index_select(0, idx), "mask": self.masks.index_select(0, idx),
-                "dt": self.dts.index_select(0, idx)}
+        items = {"index": idx, "image": self.images.index_select(0, idx), "mask": self.masks.index_select(0, idx),
+                 "dt": self.dts.index_select(0, idx)}
+        if self.pitch_labels is not None:
+            items["pitch_label"] = self.pitch_labels.index_select(0, idx)
+        return items
 
 
 class StepBatchSampler(Sampler[list[int]]):
@@ -140,7 +160,9 @@ def make_loader(dataset: VaseDataset, sampler: StepBatchSampler) -> Iterator[dic
 def to_batch(items: dict, device: torch.device, target: Decomposition | None = None) -> Batch:
     """A `VaseDataset.batch` dict (B x 3 x S x S uint8 images, B x S x S bool masks) as a float Batch on `device`."""
     image = items["image"].to(device).float() / 255.0
-    return Batch(image, items["mask"].to(device).float(), items["dt"].to(device), target)
+    label = items.get("pitch_label")
+    return Batch(image, items["mask"].to(device).float(), items["dt"].to(device), target,
+                 None if label is None else label.to(device))
 
 
 def _target_maps(ref: SampleRef, tex: tuple[int, int], env: tuple[int, int], gamma: float):

@@ -31,12 +31,14 @@ class Batch:
         mask: B x H x W target silhouette (0/1 float).
         dt: B x H x W distance transform of the mask (image sides).
         target: ground truth (synthetic data only) or None.
+        pitch_label: B pitches (deg) from `radar derender --pitch search` (loss.pitch_label_weight) or None.
     """
 
     image: torch.Tensor
     mask: torch.Tensor
     dt: torch.Tensor
     target: Decomposition | None = None
+    pitch_label: torch.Tensor | None = None
 
 
 @dataclass(frozen=True)
@@ -220,6 +222,12 @@ def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig, disc:
                                       lc.sad_patches_per_image, lc.sad_group_fraction)
         terms["sad"] = L.sad_generator_loss(disc, fake)
         total = total + lc.sad_weight * terms["sad"]
+    if lc.pitch_label_weight > 0:
+        if batch.pitch_label is None:
+            raise ValueError("loss.pitch_label_weight > 0 needs the batch's pitch labels (radar train --pitch-labels)")
+        lo, hi = config.model.geometry.pitch_range
+        terms["pitch_label"] = (pred.pose[:, 0] - batch.pitch_label).abs().mean() / (hi - lo)
+        total = total + lc.pitch_label_weight * terms["pitch_label"]
     if lc.cycle_weight > 0 or lc.light_cycle_weight > 0:
         if model is None:
             raise ValueError("loss.cycle_weight or loss.light_cycle_weight > 0 needs the model")

@@ -146,7 +146,7 @@ def apply_overrides(config: RunConfig, iterations: int | None, overfit: int | No
 def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: bool = False,
           device: str | None = None, overfit: int | None = None, iterations: int | None = None,
           progress: bool = True, init: str | Path | None = None, threads: int | None = None,
-          max_minutes: float | None = None) -> TrainSummary:
+          max_minutes: float | None = None, pitch_labels: str | Path | None = None) -> TrainSummary:
     """Train RADAR on DATA/train and write checkpoints, metrics and images to run_dir.
 
     Args:
@@ -163,6 +163,8 @@ def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: 
         threads: CPU threads (overrides config.train.threads).
         max_minutes: wall-time budget of the loop: once a step ends past it, a checkpoint is written and the
             run stops (continue it with resume=True), e.g. inside a batch job's time limit.
+        pitch_labels: a `radar derender --pitch search` results folder of the training split, one
+            <sample id>/material.json each (needed when loss.pitch_label_weight > 0).
 
     Returns:
         TrainSummary.
@@ -178,17 +180,24 @@ def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: 
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
     try:
-        return _run(config, Path(data_dir), run_dir, resume, overfit, info, progress, init, max_minutes)
+        return _run(config, Path(data_dir), run_dir, resume, overfit, info, progress, init, max_minutes,
+                    pitch_labels)
     finally:
         D.teardown(info)
 
 
 def _run(config: RunConfig, data_dir: Path, run_dir: Path, resume: bool, overfit: int | None,
-         info: D.DistInfo, progress: bool, init: str | Path | None, max_minutes: float | None) -> TrainSummary:
+         info: D.DistInfo, progress: bool, init: str | Path | None, max_minutes: float | None,
+         pitch_labels: str | Path | None) -> TrainSummary:
     t = config.train
     dataset = VaseDataset(data_dir, "train", config.model.render.image_size, limit=overfit)
     if config.loss.supervised:
         dataset.load_targets()
+    if config.loss.pitch_label_weight > 0:
+        if pitch_labels is None:
+            raise InputError("loss.pitch_label_weight > 0 needs --pitch-labels (a `radar derender --pitch search` "
+                             "results folder of the training split)")
+        dataset.load_pitch_labels(pitch_labels)
     state = build_state(config, info.device)
     resuming = resume and (init is None or bool(list_checkpoints(run_dir)))
     start = _resume(run_dir, config, state) if resuming else 0
