@@ -202,6 +202,12 @@ def material_l1(pred: tuple[torch.Tensor, ...], target: tuple[torch.Tensor, ...]
     }
 
 
+def pitch_label_l1(pitch: torch.Tensor, label: torch.Tensor, ranges: dict[str, tuple[float, float]]) -> torch.Tensor:
+    """Self-training on pitch (loss.pitch_label_weight): L1 of B predicted pitches against B labels (deg), both
+    mapped to [0, 1] by ranges["pitch"] like the supervised pose term."""
+    return (_unit(pitch, *ranges["pitch"]) - _unit(label, *ranges["pitch"])).abs().mean()
+
+
 def supervised_loss(pred: Decomposition, target: Decomposition, ranges: dict[str, tuple[float, float]]) -> dict:
     """The supervised baseline of Table 2: L1 of every output against ground truth, each mapped to [0, 1] by
     its range so the terms weigh alike.

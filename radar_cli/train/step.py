@@ -225,8 +225,7 @@ def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig, disc:
     if lc.pitch_label_weight > 0:
         if batch.pitch_label is None:
             raise ValueError("loss.pitch_label_weight > 0 needs the batch's pitch labels (radar train --pitch-labels)")
-        lo, hi = config.model.geometry.pitch_range
-        terms["pitch_label"] = (pred.pose[:, 0] - batch.pitch_label).abs().mean() / (hi - lo)
+        terms["pitch_label"] = L.pitch_label_l1(pred.pose[:, 0], batch.pitch_label, output_ranges(config))
         total = total + lc.pitch_label_weight * terms["pitch_label"]
     if lc.cycle_weight > 0 or lc.light_cycle_weight > 0:
         if model is None:
