@@ -77,10 +77,12 @@ table2: $(STAMP)
 syn-data-cpu: $(STAMP)
 	$(RADAR) synth --out data/syn_cpu --size 64 --workers $(WORKERS)
 
-# The bundled model's seven stages: the paper's losses, then a sharp silhouette, then the mouth term, then the
+# The bundled model's eight stages: the paper's losses, then a sharp silhouette, then the mouth term, then the
 # mouth term continued with a second learning-rate ramp (resumed from stage 3's last checkpoint), then the shape
 # cycle (a fine-tune of stage 4), then the lighting cycle as well (a fine-tune of stage 5), then both cycles
-# redrawing with the divided albedo (a fine-tune of stage 6); --resume continues a killed fine-tune.
+# redrawing with the divided albedo (a fine-tune of stage 6), then self-training on pitch (a fine-tune of stage 7
+# towards the pitches its own `--pitch search` finds on the training vases); --resume continues a killed fine-tune
+# and a re-run `radar derender` skips the objects it has finished.
 train-syn-cpu: $(STAMP)
 	$(RADAR) train --config pipelines/syn_vases_cpu.toml --data data/syn_cpu --out runs/syn_cpu --device cpu $(TRAIN_THREADS)
 	$(RADAR) train --config pipelines/syn_vases_cpu_sharp.toml --init runs/syn_cpu/checkpoints/step_0006500.safetensors \
@@ -102,9 +104,14 @@ train-syn-cpu: $(STAMP)
 	$(RADAR) train --config pipelines/syn_vases_cpu_divided.toml --resume \
 		--init runs/syn_cpu_light/checkpoints/step_0004000.safetensors --data data/syn_cpu \
 		--out runs/syn_cpu_divided --device cpu $(TRAIN_THREADS)
+	$(RADAR) derender data/syn_cpu/train --checkpoint runs/syn_cpu_divided/model.safetensors \
+		--out results/syn_cpu_train_search --views 0 --pitch search --workers $(WORKERS)
+	$(RADAR) train --config pipelines/syn_vases_cpu_selftrain.toml --resume \
+		--init runs/syn_cpu_divided/checkpoints/step_0002000.safetensors --pitch-labels results/syn_cpu_train_search \
+		--data data/syn_cpu --out runs/syn_cpu_selftrain --device cpu $(TRAIN_THREADS)
 
 eval-syn-cpu: $(STAMP)
-	$(RADAR) derender data/syn_cpu/test --checkpoint runs/syn_cpu_divided/model.safetensors --out results/syn_cpu \
+	$(RADAR) derender data/syn_cpu/test --checkpoint runs/syn_cpu_selftrain/model.safetensors --out results/syn_cpu \
 		--views 0 --albedo $(ALBEDO) --pitch $(PITCH)
 	$(RADAR) eval --pred results/syn_cpu --gt data/syn_cpu --json results/syn_cpu/eval.json
 
