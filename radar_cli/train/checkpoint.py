@@ -148,18 +148,21 @@ def restore(path: str | Path, config: RunConfig, state: TrainState) -> int:
     return state.step
 
 
-def initialise(path: str | Path, state: TrainState) -> None:
+def initialise(path: str | Path, state: TrainState) -> bool:
     """Start a new run from the weights of another run's checkpoint or exported model (`radar train --init`):
     the networks (and the discriminator, when the file has one) are loaded; optimizers and the step start afresh.
     The loss and render settings may differ (e.g. a sharper silhouette for fine-tuning); the architecture may not.
+    Returns whether the discriminator was loaded (an exported model.safetensors has none).
 
     Raises:
         CheckpointError: corrupt file, or weights that do not fit the model being trained.
     """
     tensors, _, _ = read_checkpoint(path)
     _load_module(state.model, tensors, "model", Path(path))
-    if any(k.startswith("disc.") for k in tensors):
-        _load_module(state.disc, tensors, "disc", Path(path))
+    if not any(k.startswith("disc.") for k in tensors):
+        return False
+    _load_module(state.disc, tensors, "disc", Path(path))
+    return True
 
 
 def export_weights(checkpoint: str | Path, out: str | Path) -> Path:

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import torch
+from tqdm import tqdm
 
 from radar_cli.errors import InputError, RadarError
 from radar_cli.model.config import RunConfig, TrainConfig
@@ -201,8 +202,9 @@ def _run(config: RunConfig, data_dir: Path, run_dir: Path, resume: bool, overfit
     state = build_state(config, info.device)
     resuming = resume and (init is None or bool(list_checkpoints(run_dir)))
     start = _resume(run_dir, config, state) if resuming else 0
-    if init is not None and not resuming:
-        initialise(init, state)
+    if init is not None and not resuming and not initialise(init, state) and uses_sad(config) and info.is_main:
+        tqdm.write(f"{init}: no discriminator in it (a model file): L_SAD's D starts afresh; --init a checkpoint "
+                   "to keep the one it was trained with")
     model, disc = D.wrap(state.model, info), D.wrap(state.disc, info)
     sampler = StepBatchSampler(len(dataset), t.batch_size, t.seed, start, t.iterations, info.rank, info.world)
     logger = RunLogger(run_dir, start, t.iterations, enabled=info.is_main, bar=progress)

@@ -96,7 +96,7 @@ def test_init_starts_a_new_run_from_weights_with_other_loss_settings(saved, tmp_
         model=dataclasses.replace(config.model, render=dataclasses.replace(config.model.render, sil_sigma_px=0.25)),
         train=dataclasses.replace(config.train, seed=7))
     fresh = build_state(sharper, torch.device("cpu"))
-    initialise(list_checkpoints(run)[-1], fresh)
+    assert initialise(list_checkpoints(run)[-1], fresh)  # the discriminator came along
     assert fresh.step == 0  # a new run: step and optimizers start afresh
     assert not fresh.opt_model.state
     for a, b in zip(fresh.model.state_dict().values(), state.model.state_dict().values()):
@@ -105,7 +105,7 @@ def test_init_starts_a_new_run_from_weights_with_other_loss_settings(saved, tmp_
         assert torch.equal(a, b)
     # an exported model file (no discriminator) also initialises the networks
     exported = export_weights(list_checkpoints(run)[-1], tmp_path / "model.safetensors")
-    initialise(exported, build_state(sharper, torch.device("cpu")))
+    assert not initialise(exported, build_state(sharper, torch.device("cpu")))  # networks only
     wider = dataclasses.replace(config, model=dataclasses.replace(config.model, albedo_width=16))
     with pytest.raises(CheckpointError, match="model weights do not fit"):
         initialise(exported, build_state(wider, torch.device("cpu")))

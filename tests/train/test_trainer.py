@@ -93,6 +93,15 @@ def test_init_fine_tunes_from_another_run_and_resumes_its_own(vases32, tmp_path)
     assert resumed.start == 1 and resumed.end == 2
 
 
+def test_init_from_a_model_file_says_the_discriminator_starts_afresh(vases32, tmp_path, capsys):
+    first = train(tiny_config(iterations=1), vases32, tmp_path / "a", progress=False)
+    train(tiny_config(iterations=1), vases32, tmp_path / "b", progress=False, init=first.checkpoint)
+    assert "discriminator" not in capsys.readouterr().out
+    model_file = tmp_path / "a" / "model.safetensors"
+    train(tiny_config(iterations=1), vases32, tmp_path / "c", progress=False, init=model_file)
+    assert f"{model_file}: no discriminator in it" in capsys.readouterr().out
+
+
 def test_resume_without_checkpoint_is_an_error(vases32, tmp_path):
     with pytest.raises(RadarError, match="no checkpoint"):
         train(tiny_config(), vases32, tmp_path / "empty", resume=True, progress=False)
