@@ -88,8 +88,11 @@ def render_object(state: ObjectState, size: int, yaw_deg: float = 0.0, pitch_deg
 
 
 @torch.no_grad()
-def write_input_view(folder: Path, state: ObjectState, size: int) -> None:
-    """mask.png, mask_front.png, albedo_rendered.png, normal_rendered.png and recon.png at the input's size."""
+def write_input_view(folder: Path, state: ObjectState, size: int) -> ViewRenderer:
+    """mask.png, mask_front.png, albedo_rendered.png, normal_rendered.png and recon.png at the input's size.
+
+    Returns:
+        The input view's renderer (its rays serve other views of the same size and pose)."""
     view = ViewRenderer(state, size)
     hits = view.hits
     coverage = torch.where(hits.mask, torch.ones_like(hits.sil), hits.sil)  # 1 x S x S
@@ -103,6 +106,7 @@ def write_input_view(folder: Path, state: ObjectState, size: int) -> None:
     normals = torch.where(hits.mask[..., None], (hits.normal + 1) / 2, torch.zeros_like(hits.normal))
     write_image(folder / NORMAL_RENDERED_FILE, to_uint8(normals[0].numpy()))
     write_image(folder / RECON_FILE, view.draw(view.shading()))
+    return view
 
 
 def sphere_profile() -> tuple[torch.Tensor, torch.Tensor]:
@@ -167,10 +171,11 @@ def write_relit(folder: Path, view: ViewRenderer, envs: dict[str, np.ndarray]) -
 
 def write_renders(folder: Path, state: ObjectState, input_size: int, view_size: int, frames: int,
                   envs: dict[str, np.ndarray]) -> None:
-    """Every render of one object."""
-    write_input_view(folder, state, input_size)
+    """Every render of one object; the turntable and relit views reuse the input view's rays at its size."""
+    input_view = write_input_view(folder, state, input_size)
     write_image(folder / MATERIAL_SPHERE_FILE, material_sphere(state, view_size))
-    view = ViewRenderer(texture_for_size(state, view_size), view_size)
+    hits = input_view.hits if view_size == input_size else None
+    view = ViewRenderer(texture_for_size(state, view_size), view_size, hits=hits)
     if frames > 0:
         write_turntable(folder, view, frames)
     write_relit(folder, view, envs)

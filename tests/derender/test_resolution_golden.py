@@ -59,7 +59,7 @@ def run_network_size(root: Path, **resolution) -> dict[str, str]:
 
 
 def test_network_side_reproduces_the_network_outputs(tmp_path: Path) -> None:
-    found = run_network_size(tmp_path, **({"resolution": SETUP.image_size} if _has_resolution() else {}))
+    found = run_network_size(tmp_path, resolution=SETUP.image_size)
     if os.environ.get("RADAR_WRITE_GOLDEN"):
         GOLDEN.write_text(json.dumps(found, indent=1, sort_keys=True) + "\n")
     expected = json.loads(GOLDEN.read_text())
@@ -67,8 +67,3 @@ def test_network_side_reproduces_the_network_outputs(tmp_path: Path) -> None:
     changed = [name for name in expected if found[name] != expected[name]]
     assert not changed, f"files that differ from the network-size outputs: {changed}"
 
-
-def _has_resolution() -> bool:
-    import dataclasses
-
-    return any(f.name == "resolution" for f in dataclasses.fields(DerenderOptions))
