@@ -9,12 +9,12 @@ from pathlib import Path
 import numpy as np
 
 from radar_cli.derender.inputs import InputItem, Prepared
-from radar_cli.derender.maps import write_maps
+from radar_cli.derender.maps import write_maps, write_picture
 from radar_cli.derender.mesh import write_meshes
 from radar_cli.derender.predictor import AlbedoSource, ModelSetup, PitchSource
 from radar_cli.derender.renders import write_renders
 from radar_cli.derender.state import ObjectState
-from radar_cli.fileio import write_image, write_json
+from radar_cli.fileio import write_json
 from radar_cli.results import INPUT_FILE, MATERIAL_FILE
 
 
@@ -63,7 +63,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
     folder.mkdir(parents=True, exist_ok=True)
     (folder / MATERIAL_FILE).unlink(missing_ok=True)  # incomplete until rewritten at the end
     side = prepared.side
-    write_image(folder / INPUT_FILE, prepared.photo_image)
+    write_picture(folder / INPUT_FILE, prepared.photo_image)
     write_maps(folder, state, setup.render)
     write_meshes(folder, state, setup.geometry.n_cols)
     write_renders(folder, state, side, config.view_side(side), config.views, envs)
