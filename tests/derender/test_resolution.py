@@ -152,3 +152,21 @@ def test_cli_photo_resolution_with_the_bundled_model(tmp_path: Path) -> None:
     with Image.open(tmp_path / "o" / "v" / "recon.png") as im:
         assert im.size == (256, 256)
     assert json.loads((tmp_path / "o" / "v" / "material.json").read_text())["resolution"] == 256
+
+
+def test_large_exports_encode_fast_and_keep_their_pixels(tmp_path: Path) -> None:
+    from radar_cli.derender.maps import FAST_ENCODE_PIXELS, write_picture
+    from radar_cli.derender.renders import gif_frames
+
+    rng = np.random.default_rng(0)
+    image = rng.integers(0, 256, (512, 512, 3), dtype=np.uint8)
+    assert image.shape[0] * image.shape[1] >= FAST_ENCODE_PIXELS
+    write_picture(tmp_path / "big.png", image)
+    np.testing.assert_array_equal(np.asarray(Image.open(tmp_path / "big.png")), image)  # lossless
+    ramp = np.broadcast_to(np.linspace(0, 255, 512, dtype=np.uint8)[None, :, None], (512, 512, 3))
+    views = [np.ascontiguousarray(np.roll(ramp, 64 * k, axis=1)) for k in range(3)]
+    frames = gif_frames(views)
+    assert all(f.mode == "P" and f.getpalette() == frames[0].getpalette() for f in frames)  # one shared palette
+    for frame, view in zip(frames, views):
+        assert np.abs(np.asarray(frame.convert("RGB"), np.float64) - view).mean() < 0.5  # grey levels
+    assert all(f.mode == "RGB" for f in gif_frames([v[:256, :256] for v in views]))  # small: Pillow's own
