@@ -86,22 +86,24 @@ def _export_cost(predictor: Predictor, photo_dir: Path, out: Path, resolution: R
     prepared = [prepare(item, setup.image_size, resolution=resolution) for item in items]
     dec = predictor.predict([p.image for p in prepared], [p.silhouette for p in prepared])
     envs = environments((), setup.render.env_height, setup.render.env_width)
-    state_s, write_s = [], []
+    state_s, write_s, cpu_s = [], [], []
     rss_before = _rss_mib()
     with torch_threads(EXPORT_THREADS):
         for k, (item, prep) in enumerate(zip(items, prepared)):
-            start = time.perf_counter()
+            start, cpu = time.perf_counter(), time.process_time()
             state = full_resolution_state(dec.select(k), prep, setup, predictor.albedo)
             middle = time.perf_counter()
             export_object(out / item.name, item, prep, state, setup, predictor.version, envs, export,
                           predictor.albedo, predictor.pitch)
             state_s.append(middle - start)
             write_s.append(time.perf_counter() - middle)
+            cpu_s.append(time.process_time() - cpu)
     return {
         "resolution": sorted({p.side for p in prepared}),
         "export_state_seconds": round(statistics.median(state_s), 4),
         "export_write_seconds": round(statistics.median(write_s), 3),
         "export_seconds_per_object": round(statistics.median(s + w for s, w in zip(state_s, write_s)), 3),
+        "export_cpu_seconds_per_object": round(statistics.median(cpu_s), 3),
         "rss_before_export_mib": round(rss_before, 1),
         "peak_rss_mib": round(_peak_rss_mib(), 1),
     }
@@ -132,7 +134,9 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
     Returns:
         {"network_images_per_s", "network_images_per_cpu_s", "full_images_per_s", "full_seconds_per_image",
          "resolution", "export_state_seconds", "export_write_seconds", "export_seconds_per_object",
-         "rss_before_export_mib", "peak_rss_mib", "image_size", "photo_side", "batch_size", "n_images",
+         "export_cpu_seconds_per_object" (process CPU time: steadier than wall time on a shared machine),
+         "rss_before_export_mib", "peak_rss_mib" (after the one-at-a-time exports), "full_peak_rss_mib" (after the
+         full run with `workers` threads), "image_size", "photo_side", "batch_size", "n_images",
          "n_export", "device", "threads", "workers", "albedo", "pitch", "model"}; the export figures are medians
         over the objects.
     """
@@ -145,18 +149,20 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
     with tempfile.TemporaryDirectory(prefix="radar-bench-") as tmp:
         for i, image in enumerate(_photos(n_export, photo_side)):
             write_image(Path(tmp) / "in" / f"bench_{i:03d}.png", image)
+        # one object at a time first, so its peak memory is not the parallel run's
+        cost = _export_cost(predictor, Path(tmp) / "in", Path(tmp) / "one", resolution, export)
         options = DerenderOptions(out=Path(tmp) / "out", batch_size=batch_size, workers=workers, threads=threads,
                                   export=export, resolution=resolution)
         start = time.perf_counter()
         summary = derender([Path(tmp) / "in"], predictor, options, say=lambda line: None)
         full = time.perf_counter() - start
-        cost = _export_cost(predictor, Path(tmp) / "in", Path(tmp) / "one", resolution, export)
     return {
         "network_images_per_s": round(net_wall, 2),
         "network_images_per_cpu_s": round(net_cpu, 2),
         "full_images_per_s": round(len(summary.done) / full, 3),
         "full_seconds_per_image": round(full / max(len(summary.done), 1), 2),
         "failed": len(summary.failures),
+        "full_peak_rss_mib": round(_peak_rss_mib(), 1),
         **cost,
         "image_size": size,
         "photo_side": photo_side,
