@@ -60,7 +60,7 @@ RESOLUTION = ResolutionType()
               help="Side in pixels of the outputs (crop, renders, the frontal third of the maps): an integer, "
                    "or 'photo' for each crop's own size; never more than the crop's pixels in the photo. At the "
                    "network's side the network-only outputs are written.")
-@click.option("--view-size", type=click.IntRange(16, 2048), default=None,
+@click.option("--view-size", type=click.IntRange(16, 1024), default=None,
               help="Side in pixels of turntable frames, relit views and the material sphere "
                    f"[default: the output side, at least {MIN_VIEW_SIZE}].")
 @click.option("--env", "envs", multiple=True, type=click.Path(dir_okay=False, path_type=Path),

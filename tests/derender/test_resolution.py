@@ -87,8 +87,8 @@ def test_never_above_the_photo_and_photo_means_its_own_size(tmp_path: Path) -> N
     assert prepared.photo_image.shape == (native, native, 3) and prepared.photo_silhouette.shape == (native, native)
     assert prepare(item, SIZE, resolution="photo").side == native
     assert prepare(item, SIZE, resolution=32).side == 32
-    assert output_side("photo", 10_000) == 2048 and output_side(100, 60) == 60
-    for bad in (8, 4096, "big", 1.5):
+    assert output_side("photo", 10_000) == 1024 and output_side(100, 60) == 60
+    for bad in (8, 2048, "big", 1.5):
         with pytest.raises(InputError, match="resolution"):
             output_side(bad, 100)
 
@@ -138,7 +138,7 @@ def test_divided_albedo_at_the_output_side_draws_the_crop_back(tmp_path: Path) -
 
 def test_cli_resolution_option(tmp_path: Path) -> None:
     result = CliRunner().invoke(cli, ["derender", str(tmp_path), "--out", str(tmp_path / "o"), "--resolution", "8"])
-    assert result.exit_code == 2 and "8 is not in [16, 2048]" in result.output
+    assert result.exit_code == 2 and "8 is not in [16, 1024]" in result.output
     result = CliRunner().invoke(cli, ["derender", str(tmp_path), "--out", str(tmp_path / "o"), "--resolution", "x"])
     assert result.exit_code == 2 and "'photo'" in result.output
 
