@@ -170,3 +170,15 @@ def test_large_exports_encode_fast_and_keep_their_pixels(tmp_path: Path) -> None
     for frame, view in zip(frames, views):
         assert np.abs(np.asarray(frame.convert("RGB"), np.float64) - view).mean() < 0.5  # grey levels
     assert all(f.mode == "RGB" for f in gif_frames([v[:256, :256] for v in views]))  # small: Pillow's own
+
+
+def test_known_mask_is_cut_at_both_sides(tmp_path: Path) -> None:
+    photo = write_photo(tmp_path / "in" / "m.png", 6, (200, 160))
+    dark = np.asarray(Image.open(photo)).max(axis=-1) < 200
+    Image.fromarray((dark * 255).astype(np.uint8)).save(tmp_path / "m_mask.png")
+    item = InputItem("m", photo, tmp_path / "m_mask.png")
+    prepared = prepare(item, SIZE, resolution=96)
+    assert prepared.side == 96 and prepared.silhouette.shape == (SIZE, SIZE) and prepared.backdrop == "white"
+    assert prepared.photo_silhouette.shape == (96, 96)
+    assert prepared.photo_silhouette.mean() == pytest.approx(prepared.silhouette.mean(), abs=0.02)
+    assert (prepared.photo_image[~prepared.photo_silhouette] > 230).all()  # the backdrop whitened at N too
