@@ -22,9 +22,9 @@ from radar_cli.render.raycast import Hits, cast_rays
 from radar_cli.render.scene import Shading, render_front, rotate_full_map, shade
 from radar_cli.render.texture import render_texture
 from radar_cli.sor.surface import FULL_SPAN
-from radar_cli.results import (ALBEDO_RENDERED_FILE, MASK_FILE, MASK_FRONT_FILE, MATERIAL_SPHERE_FILE,
-                               NORMAL_RENDERED_FILE, RECON_FILE, RELIT_PREFIX, TURNTABLE_GIF_FILE,
-                               TURNTABLE_STRIP_FILE)
+from radar_cli.results import (ALBEDO_RENDERED_FILE, DIFFUSE_RENDERED_FILE, MASK_FILE, MASK_FRONT_FILE,
+                               MATERIAL_SPHERE_FILE, NORMAL_RENDERED_FILE, RECON_FILE, RELIT_PREFIX,
+                               SPECULAR_RENDERED_FILE, TURNTABLE_GIF_FILE, TURNTABLE_STRIP_FILE)
 
 SPHERE_ROWS = 64
 SPHERE_RADIUS = 0.8  # fraction of r_max
@@ -89,7 +89,8 @@ def render_object(state: ObjectState, size: int, yaw_deg: float = 0.0, pitch_deg
 
 @torch.no_grad()
 def write_input_view(folder: Path, state: ObjectState, size: int) -> ViewRenderer:
-    """mask.png, mask_front.png, albedo_rendered.png, normal_rendered.png and recon.png at the input's size.
+    """mask.png, mask_front.png, albedo_rendered.png, normal_rendered.png, recon.png, diffuse_rendered.png and
+    specular_rendered.png at the input's size.
 
     Returns:
         The input view's renderer (its rays serve other views of the same size and pose)."""
@@ -101,12 +102,22 @@ def write_input_view(folder: Path, state: ObjectState, size: int) -> ViewRendere
     write_picture(folder / MASK_FRONT_FILE, to_uint8(front[0, 0].numpy()))
     # drawn as radar synth draws its ground truth (black off the hard silhouette), so radar eval compares like
     # with like at the outline
-    albedo, _ = render_texture(hits, tone_map(state.albedo, state.render.gamma), inside_dim=1.0, background=0.0)
-    write_picture(folder / ALBEDO_RENDERED_FILE, chw_image(albedo * hits.mask[:, None]))
+    write_picture(folder / ALBEDO_RENDERED_FILE, _on_object(hits, tone_map(state.albedo, state.render.gamma)))
     normals = torch.where(hits.mask[..., None], (hits.normal + 1) / 2, torch.zeros_like(hits.normal))
     write_picture(folder / NORMAL_RENDERED_FILE, to_uint8(normals[0].numpy()))
-    write_picture(folder / RECON_FILE, view.draw(view.shading()))
+    shading = view.shading()
+    write_picture(folder / RECON_FILE, view.draw(shading))
+    gamma, rho = state.render.gamma, state.rho[:, None, None, None]
+    write_picture(folder / DIFFUSE_RENDERED_FILE, _on_object(hits, tone_map(shading.diffuse, gamma)))
+    write_picture(folder / SPECULAR_RENDERED_FILE, _on_object(hits, tone_map(rho * shading.specular, gamma)))
     return view
+
+
+def _on_object(hits: Hits, texture: torch.Tensor) -> np.ndarray:
+    """A 360 deg map (1 x C x Ht x 3Wt in [0, 1]) drawn undimmed in the view, black off the hard silhouette:
+    S x S (x C) uint8."""
+    image, _ = render_texture(hits, texture, inside_dim=1.0, background=0.0)
+    return chw_image(image * hits.mask[:, None])
 
 
 def sphere_profile() -> tuple[torch.Tensor, torch.Tensor]:

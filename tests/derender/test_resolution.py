@@ -27,7 +27,7 @@ from .conftest import SETUP, SIZE, FakeModel, vase_photo, write_photo
 
 SIDE = 128
 IMAGE_SIDE = ("input.png", "mask.png", "mask_front.png", "recon.png", "albedo_rendered.png", "normal_rendered.png",
-              "texture.png", "normal.png", "diffuse.png", "specular.png", "relit_studio.png", "material_sphere.png")
+              "diffuse_rendered.png", "specular_rendered.png", "texture.png", "normal.png", "diffuse.png", "specular.png", "relit_studio.png", "material_sphere.png")
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
@@ -57,6 +57,9 @@ def test_every_output_at_the_output_side(big: Path) -> None:
         assert im.size == (3 * SIDE, SIDE)  # 360 deg, the frontal third at the crop's side
     with Image.open(folder / "turntable.png") as im:
         assert im.size == (2 * SIDE, SIDE)  # views at max(128, N)
+    mask = np.asarray(Image.open(folder / "mask.png")) == 255
+    diffuse = np.asarray(Image.open(folder / "diffuse_rendered.png"))
+    assert diffuse.ndim == 2 and (diffuse[~mask] == 0).all() and diffuse[mask].mean() > 20  # shading in the view
     record = json.loads((folder / "material.json").read_text())
     assert record["resolution"] == SIDE and record["view_size"] == SIDE and record["image_size"] == SIZE
     assert len(record["radius"]) == PROFILE_ROWS
