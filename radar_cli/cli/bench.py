@@ -6,6 +6,8 @@ import json
 
 import click
 
+from radar_cli.cli.derender import RESOLUTION
+from radar_cli.derender.inputs import DEFAULT_RESOLUTION, Resolution
 from radar_cli.errors import InputError
 
 
@@ -92,11 +94,14 @@ def synth(size: int, n: int, workers: int, shading_size: int) -> None:
               help="radar derender --albedo.")
 @click.option("--pitch", type=click.Choice(["network", "search"]), default="network", show_default=True,
               help="radar derender --pitch.")
+@click.option("--resolution", type=RESOLUTION, default=str(DEFAULT_RESOLUTION), show_default=True,
+              help="radar derender --resolution (the benchmark's photos are 1.6 x this side).")
 def derender(checkpoint: str | None, device: str, images: int, exports: int, batch_size: int, threads: int,
-             workers: int, albedo: str, pitch: str) -> None:
-    """Images per second for the network alone and for the full de-rendering with all exports."""
+             workers: int, albedo: str, pitch: str, resolution: Resolution) -> None:
+    """Images per second for the network alone and for the full de-rendering with all exports; seconds per
+    object and peak memory of the export at the output resolution."""
     from radar_cli.derender.benchmark import bench_derender
 
     click.echo(json.dumps(bench_derender(checkpoint, device, images, exports, batch_size, threads, workers=workers,
-                                         albedo=albedo, pitch=pitch),  # type: ignore[arg-type]
+                                         albedo=albedo, pitch=pitch, resolution=resolution),  # type: ignore[arg-type]
                           indent=2))

@@ -9,8 +9,29 @@ import click
 
 from radar_cli.derender.batch import DerenderOptions, derender as run_derender
 from radar_cli.derender.contact_sheet import contact_sheet as write_contact_sheet
-from radar_cli.derender.export import ExportConfig
+from radar_cli.derender.export import MIN_VIEW_SIZE, ExportConfig
+from radar_cli.derender.inputs import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION, Resolution
 from radar_cli.derender.predictor import ALBEDO_SOURCES, PITCH_SOURCES, Predictor
+
+
+class ResolutionType(click.ParamType):
+    """--resolution: an integer side in [MIN_RESOLUTION, MAX_RESOLUTION] or `photo`."""
+
+    name = "SIDE|photo"
+
+    def convert(self, value, param, ctx) -> Resolution:
+        if value == "photo" or isinstance(value, int):
+            return value
+        try:
+            side = int(value)
+        except ValueError:
+            self.fail(f"expected an integer side in px or 'photo', got {value!r}", param, ctx)
+        if not MIN_RESOLUTION <= side <= MAX_RESOLUTION:
+            self.fail(f"{side} is not in [{MIN_RESOLUTION}, {MAX_RESOLUTION}]", param, ctx)
+        return side
+
+
+RESOLUTION = ResolutionType()
 
 
 @click.command("derender")
@@ -35,8 +56,13 @@ from radar_cli.derender.predictor import ALBEDO_SOURCES, PITCH_SOURCES, Predicto
               help="network: the shape network's pitch; search: the pitch whose re-rendering best matches the "
                    "photo and its silhouette, searched over the range (slower).")
 @click.option("--views", type=click.IntRange(0, 360), default=8, show_default=True, help="Turntable frames.")
-@click.option("--view-size", type=click.IntRange(16, 1024), default=128, show_default=True,
-              help="Side in pixels of turntable frames, relit views and the material sphere.")
+@click.option("--resolution", type=RESOLUTION, default=str(DEFAULT_RESOLUTION), show_default=True,
+              help="Side in pixels of the outputs (crop, renders, the frontal third of the maps): an integer, "
+                   "or 'photo' for each crop's own size; never more than the crop's pixels in the photo. At the "
+                   "network's side the network-only outputs are written.")
+@click.option("--view-size", type=click.IntRange(16, 1024), default=None,
+              help="Side in pixels of turntable frames, relit views and the material sphere "
+                   f"[default: the output side, at least {MIN_VIEW_SIZE}].")
 @click.option("--env", "envs", multiple=True, type=click.Path(dir_okay=False, path_type=Path),
               help="Extra relighting environment map (.hdr, .exr, .png, .npy); repeatable.")
 @click.option("--batch-size", type=click.IntRange(1, 1024), default=8, show_default=True)
@@ -48,13 +74,14 @@ from radar_cli.derender.predictor import ALBEDO_SOURCES, PITCH_SOURCES, Predicto
 @click.option("--contact-sheet", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Also write a contact sheet PNG (input, reconstruction, albedo, relit view per object).")
 def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks: Path | None, crop: str,
-             backdrop: str, device: str, albedo: str, pitch: str, views: int, view_size: int, envs: tuple[Path, ...],
+             backdrop: str, device: str, albedo: str, pitch: str, resolution: Resolution, views: int,
+             view_size: int | None, envs: tuple[Path, ...],
              batch_size: int, workers: int, threads: int, overwrite: bool, contact_sheet: Path | None) -> None:
     """De-render INPUTS (image files, folders, prepared dataset folders) into --out."""
     predictor = Predictor.from_checkpoint(checkpoint, device, albedo, pitch)  # type: ignore[arg-type]
     options = DerenderOptions(out=out, crop=crop, backdrop=backdrop, masks=masks,  # type: ignore[arg-type]
                               envs=envs, batch_size=batch_size, workers=workers, threads=threads, overwrite=overwrite,
-                              export=ExportConfig(views, view_size))
+                              export=ExportConfig(views, view_size), resolution=resolution)
     summary = run_derender(list(inputs), predictor, options, say=lambda line: click.echo(line, err=True))
     if contact_sheet is not None and (summary.done or summary.skipped):
         click.echo(f"contact sheet: {write_contact_sheet(out, contact_sheet)}")

@@ -19,9 +19,11 @@ from tqdm import tqdm
 
 from radar_cli.derender.environments import builtin_environments, env_name, load_environment
 from radar_cli.derender.export import ExportConfig, export_object, is_complete
-from radar_cli.derender.inputs import Backdrop, CropMode, Failure, InputItem, Prepared, collect_inputs, prepare
+from radar_cli.derender.inputs import (DEFAULT_RESOLUTION, Backdrop, CropMode, Failure, InputItem, Prepared,
+                                       Resolution, collect_inputs, output_side, prepare)
 from radar_cli.derender.predictor import Predictor
 from radar_cli.derender.report import write_report
+from radar_cli.derender.upsample import full_resolution_state
 from radar_cli.errors import InputError, RadarError
 from radar_cli.model.outputs import Decomposition
 
@@ -46,6 +48,8 @@ class DerenderOptions:
     """torch intra-op threads for the network; on a busy 2-core machine one thread ran it 15x faster than two."""
     overwrite: bool = False
     export: ExportConfig = field(default_factory=ExportConfig)
+    resolution: Resolution = DEFAULT_RESOLUTION
+    """Side of the outputs (inputs.output_side): an integer, or `photo` for each crop's own size."""
 
 
 @dataclass
@@ -98,7 +102,7 @@ def _prepare_all(items: list[InputItem], size: int, options: DerenderOptions) ->
     """Read and crop a batch of inputs (threads: decoding and detection release the GIL)."""
     def one(item: InputItem) -> Prepared | Failure:
         try:
-            return prepare(item, size, options.crop, options.backdrop)
+            return prepare(item, size, options.crop, options.backdrop, options.resolution)
         except RadarError as e:
             return Failure(str(item.image_path), str(e).removeprefix(f"{item.image_path}: "))
 
@@ -134,6 +138,7 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
     start = time.perf_counter()
     if options.batch_size < 1 or options.workers < 0 or options.threads < 1:
         raise InputError("--batch-size and --threads must be >= 1, --workers >= 0")
+    output_side(options.resolution, 1)  # checks it before any work
     render = predictor.setup.render
     envs = environments(options.envs, render.env_height, render.env_width)
     items, failures = collect_inputs(list(inputs), options.masks, exclude=options.out)
@@ -178,8 +183,9 @@ def _export_all(ok: list[tuple[InputItem, Prepared]], dec: Decomposition, predic
     def one(k: int) -> Failure | None:
         item, prep = ok[k]
         try:
-            export_object(options.out / item.name, item, prep, dec.select(k), predictor.setup,
-                          predictor.version, envs, options.export, predictor.albedo, predictor.pitch)
+            state = full_resolution_state(dec.select(k), prep, predictor.setup, predictor.albedo)
+            export_object(options.out / item.name, item, prep, state, predictor.setup, predictor.version, envs,
+                          options.export, predictor.albedo, predictor.pitch)
         except ITEM_ERRORS as e:
             return Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
         return None

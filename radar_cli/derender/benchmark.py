@@ -1,8 +1,10 @@
 """`radar bench derender`: images per second for the network alone and for the whole de-rendering with every
-export, on this machine."""
+export, and the seconds and memory of one object's export at the output resolution, on this machine."""
 
 from __future__ import annotations
 
+import resource
+import statistics
 import tempfile
 import time
 from pathlib import Path
@@ -10,12 +12,29 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from radar_cli.derender.batch import DerenderOptions, derender, torch_threads
-from radar_cli.derender.export import ExportConfig
+from radar_cli.derender.batch import EXPORT_THREADS, DerenderOptions, derender, environments, torch_threads
+from radar_cli.derender.export import ExportConfig, export_object
+from radar_cli.derender.inputs import DEFAULT_RESOLUTION, InputItem, Resolution, output_side, prepare
 from radar_cli.derender.predictor import AlbedoSource, PitchSource, Predictor
+from radar_cli.derender.upsample import full_resolution_state
 from radar_cli.fileio import write_image
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+PHOTO_MARGIN = 1.6  # photos this much larger than the output side: the examples' crop windows span 0.68-1.05 of them
+
+
+def _rss_mib() -> float:
+    """This process's resident memory now, MiB (Linux /proc; 0 elsewhere)."""
+    try:
+        pages = int(Path("/proc/self/statm").read_text().split()[1])
+    except (OSError, ValueError, IndexError):
+        return 0.0
+    return pages * resource.getpagesize() / 2**20
+
+
+def _peak_rss_mib() -> float:
+    """This process's peak resident memory so far, MiB (ru_maxrss is KiB on Linux)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
 def _photos(n: int, size: int, seed: int = 0) -> list[np.ndarray]:
@@ -58,18 +77,51 @@ def _network_rate(predictor: Predictor, images: list[np.ndarray], batch_size: in
     return len(images) / (time.perf_counter() - wall), len(images) / max(time.process_time() - cpu, 1e-9)
 
 
+def _export_cost(predictor: Predictor, photo_dir: Path, out: Path, resolution: Resolution,
+                 export: ExportConfig) -> dict:
+    """Seconds per object of building the output-resolution state and of writing every file, one object at a
+    time on EXPORT_THREADS torch threads (as radar derender exports), and the memory it took."""
+    setup = predictor.setup
+    items = [InputItem(p.stem, p) for p in sorted(photo_dir.glob("*.png"))]
+    prepared = [prepare(item, setup.image_size, resolution=resolution) for item in items]
+    dec = predictor.predict([p.image for p in prepared], [p.silhouette for p in prepared])
+    envs = environments((), setup.render.env_height, setup.render.env_width)
+    state_s, write_s, cpu_s = [], [], []
+    rss_before = _rss_mib()
+    with torch_threads(EXPORT_THREADS):
+        for k, (item, prep) in enumerate(zip(items, prepared)):
+            start, cpu = time.perf_counter(), time.process_time()
+            state = full_resolution_state(dec.select(k), prep, setup, predictor.albedo)
+            middle = time.perf_counter()
+            export_object(out / item.name, item, prep, state, setup, predictor.version, envs, export,
+                          predictor.albedo, predictor.pitch)
+            state_s.append(middle - start)
+            write_s.append(time.perf_counter() - middle)
+            cpu_s.append(time.process_time() - cpu)
+    return {
+        "resolution": sorted({p.side for p in prepared}),
+        "export_state_seconds": round(statistics.median(state_s), 4),
+        "export_write_seconds": round(statistics.median(write_s), 3),
+        "export_seconds_per_object": round(statistics.median(s + w for s, w in zip(state_s, write_s)), 3),
+        "export_cpu_seconds_per_object": round(statistics.median(cpu_s), 3),
+        "rss_before_export_mib": round(rss_before, 1),
+        "peak_rss_mib": round(_peak_rss_mib(), 1),
+    }
+
+
 def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_images: int = 32,
                    n_export: int = 4, batch_size: int = 8, threads: int = 1,
                    export: ExportConfig = ExportConfig(), predictor: Predictor | None = None,
                    workers: int = 2, albedo: AlbedoSource = "divided",
-                   pitch: PitchSource = "network") -> dict:
+                   pitch: PitchSource = "network", resolution: Resolution = DEFAULT_RESOLUTION) -> dict:
     """Measure de-rendering speed.
 
     Args:
         checkpoint: model weights (default: the bundled model).
         device: auto, cpu, cuda.
-        n_images: images pushed through the network alone.
-        n_export: images de-rendered end to end (read, crop, network, all exports, report).
+        n_images: images pushed through the network alone (at its side S).
+        n_export: images de-rendered end to end (read, crop, network, all exports, report), and then exported
+            one by one for the per-object figures; their photos are PHOTO_MARGIN x the output side.
         batch_size: network batch size.
         threads: torch intra-op threads.
         export: turntable and view settings of the full run.
@@ -77,22 +129,30 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         workers: threads cropping and exporting objects.
         albedo: the predictor's albedo source (`divided` adds the shading division to the network's time).
         pitch: the predictor's pitch source (`search` adds the pitch search).
+        resolution: radar derender --resolution.
 
     Returns:
         {"network_images_per_s", "network_images_per_cpu_s", "full_images_per_s", "full_seconds_per_image",
-         "image_size", "batch_size", "n_images", "n_export", "device", "threads", "workers", "albedo", "pitch",
-         "model"}.
+         "resolution", "export_state_seconds", "export_write_seconds", "export_seconds_per_object",
+         "export_cpu_seconds_per_object" (process CPU time: steadier than wall time on a shared machine),
+         "rss_before_export_mib", "peak_rss_mib" (after the one-at-a-time exports), "full_peak_rss_mib" (after the
+         full run with `workers` threads), "image_size", "photo_side", "batch_size", "n_images",
+         "n_export", "device", "threads", "workers", "albedo", "pitch", "model"}; the export figures are medians
+        over the objects.
     """
     predictor = predictor or Predictor.from_checkpoint(checkpoint, device, albedo, pitch)
     size = predictor.setup.image_size
     images = _photos(n_images, size)
     with torch_threads(threads):
         net_wall, net_cpu = _network_rate(predictor, images, batch_size)
+    photo_side = max(size, round(PHOTO_MARGIN * output_side(resolution, 1 << 30)))
     with tempfile.TemporaryDirectory(prefix="radar-bench-") as tmp:
-        for i, image in enumerate(_photos(n_export, size)):
+        for i, image in enumerate(_photos(n_export, photo_side)):
             write_image(Path(tmp) / "in" / f"bench_{i:03d}.png", image)
+        # one object at a time first, so its peak memory is not the parallel run's
+        cost = _export_cost(predictor, Path(tmp) / "in", Path(tmp) / "one", resolution, export)
         options = DerenderOptions(out=Path(tmp) / "out", batch_size=batch_size, workers=workers, threads=threads,
-                                  export=export)
+                                  export=export, resolution=resolution)
         start = time.perf_counter()
         summary = derender([Path(tmp) / "in"], predictor, options, say=lambda line: None)
         full = time.perf_counter() - start
@@ -102,7 +162,10 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         "full_images_per_s": round(len(summary.done) / full, 3),
         "full_seconds_per_image": round(full / max(len(summary.done), 1), 2),
         "failed": len(summary.failures),
+        "full_peak_rss_mib": round(_peak_rss_mib(), 1),
+        **cost,
         "image_size": size,
+        "photo_side": photo_side,
         "batch_size": batch_size,
         "n_images": n_images,
         "n_export": n_export,

@@ -9,14 +9,16 @@ from pathlib import Path
 import numpy as np
 
 from radar_cli.derender.inputs import InputItem, Prepared
-from radar_cli.derender.maps import write_maps
+from radar_cli.derender.maps import write_maps, write_picture
 from radar_cli.derender.mesh import write_meshes
 from radar_cli.derender.predictor import AlbedoSource, ModelSetup, PitchSource
 from radar_cli.derender.renders import write_renders
 from radar_cli.derender.state import ObjectState
-from radar_cli.fileio import write_image, write_json
-from radar_cli.model.outputs import Decomposition
+from radar_cli.fileio import write_json
 from radar_cli.results import INPUT_FILE, MATERIAL_FILE
+
+
+MIN_VIEW_SIZE = 128
 
 
 @dataclass(frozen=True)
@@ -25,8 +27,13 @@ class ExportConfig:
 
     views: int = 8
     """Turntable frames (0 = no turntable)."""
-    view_size: int = 128
-    """Side in pixels of the turntable frames, relit views and the material sphere."""
+    view_size: int | None = None
+    """Side in pixels of the turntable frames, relit views and the material sphere; None: the output side, at
+    least MIN_VIEW_SIZE."""
+
+    def view_side(self, output_side: int) -> int:
+        """The views' side for objects exported at `output_side`."""
+        return self.view_size if self.view_size is not None else max(MIN_VIEW_SIZE, output_side)
 
 
 def is_complete(folder: Path) -> bool:
@@ -34,15 +41,15 @@ def is_complete(folder: Path) -> bool:
     return (folder / MATERIAL_FILE).is_file()
 
 
-def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomposition, setup: ModelSetup,
+def export_object(folder: Path, item: InputItem, prepared: Prepared, state: ObjectState, setup: ModelSetup,
                   version: str, envs: dict[str, np.ndarray], config: ExportConfig = ExportConfig(),
                   albedo_source: AlbedoSource = "network", pitch_source: PitchSource = "network") -> dict:
-    """Write all files of one object.
+    """Write all files of one object; image-space outputs at the output side N = prepared.side.
 
     Args:
         folder: RESULTS/<name>.
-        item, prepared: the input and its crop.
-        dec: the object's Decomposition (batch of one, CPU).
+        item, prepared: the input and its crops (input.png is prepared.photo_image).
+        state: the object (upsample.full_resolution_state; its albedo any size, 1 x 3 x Ht x 3Wt).
         setup: the model's configuration.
         version: model label for material.json.
         envs: relighting environments by name (He x We each).
@@ -55,11 +62,11 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomp
     """
     folder.mkdir(parents=True, exist_ok=True)
     (folder / MATERIAL_FILE).unlink(missing_ok=True)  # incomplete until rewritten at the end
-    state = ObjectState.from_decomposition(dec, setup.render, setup.camera)
-    write_image(folder / INPUT_FILE, prepared.image)
+    side = prepared.side
+    write_picture(folder / INPUT_FILE, prepared.photo_image)
     write_maps(folder, state, setup.render)
     write_meshes(folder, state, setup.geometry.n_cols)
-    write_renders(folder, state, setup.image_size, config.view_size, config.views, envs)
+    write_renders(folder, state, side, config.view_side(side), config.views, envs)
     record = state.material()
     record.update({
         "source": str(item.image_path),
@@ -67,6 +74,8 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomp
         "photo_size": list(prepared.photo_size),
         "backdrop": prepared.backdrop,
         "image_size": setup.image_size,
+        "resolution": side,
+        "view_size": config.view_side(side),
         "model": version,
         "albedo_source": albedo_source,
         "pitch_source": pitch_source,

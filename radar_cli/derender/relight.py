@@ -26,14 +26,15 @@ def relight(folder: str | Path, env_path: str | Path, out: str | Path, yaw_deg: 
         out: the image to write (.png, .jpg, .webp).
         yaw_deg: spin about the object's axis.
         pitch_deg: camera elevation in degrees (default: the predicted pitch).
-        size: image side in pixels (default: the network's input size recorded in material.json).
+        size: image side in pixels (default: the output side recorded in material.json, else the network's).
         match: scale the map to the exposure of the object's own lighting (False: use its radiance as is).
 
     Returns:
         The path written.
     """
     state = read_state(folder)
-    size = size or int(read_record(folder).get("image_size", 256))
+    record = read_record(folder)
+    size = size or int(record.get("resolution", record.get("image_size", 256)))
     if not 8 <= size <= MAX_SIZE:
         raise InputError(f"--size must lie in [8, {MAX_SIZE}], got {size}")
     env = load_environment(env_path, state.env.shape[1], state.env.shape[2])

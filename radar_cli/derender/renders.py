@@ -14,17 +14,17 @@ from PIL import Image
 
 from radar_cli.config import CameraConfig
 from radar_cli.derender.environments import match_exposure
-from radar_cli.derender.maps import chw_image
+from radar_cli.derender.maps import FAST_ENCODE_PIXELS, chw_image, write_picture
 from radar_cli.derender.state import ObjectState
-from radar_cli.fileio import atomic_path, to_uint8, write_image
+from radar_cli.fileio import atomic_path, to_uint8
 from radar_cli.render.lighting import compose, tone_map
 from radar_cli.render.raycast import Hits, cast_rays
 from radar_cli.render.scene import Shading, render_front, rotate_full_map, shade
 from radar_cli.render.texture import render_texture
 from radar_cli.sor.surface import FULL_SPAN
-from radar_cli.results import (ALBEDO_RENDERED_FILE, MASK_FILE, MASK_FRONT_FILE, MATERIAL_SPHERE_FILE,
-                               NORMAL_RENDERED_FILE, RECON_FILE, RELIT_PREFIX, TURNTABLE_GIF_FILE,
-                               TURNTABLE_STRIP_FILE)
+from radar_cli.results import (ALBEDO_RENDERED_FILE, DIFFUSE_RENDERED_FILE, MASK_FILE, MASK_FRONT_FILE,
+                               MATERIAL_SPHERE_FILE, NORMAL_RENDERED_FILE, RECON_FILE, RELIT_PREFIX,
+                               SPECULAR_RENDERED_FILE, TURNTABLE_GIF_FILE, TURNTABLE_STRIP_FILE)
 
 SPHERE_ROWS = 64
 SPHERE_RADIUS = 0.8  # fraction of r_max
@@ -88,21 +88,36 @@ def render_object(state: ObjectState, size: int, yaw_deg: float = 0.0, pitch_deg
 
 
 @torch.no_grad()
-def write_input_view(folder: Path, state: ObjectState, size: int) -> None:
-    """mask.png, mask_front.png, albedo_rendered.png, normal_rendered.png and recon.png at the input's size."""
+def write_input_view(folder: Path, state: ObjectState, size: int) -> ViewRenderer:
+    """mask.png, mask_front.png, albedo_rendered.png, normal_rendered.png, recon.png, diffuse_rendered.png and
+    specular_rendered.png at the input's size.
+
+    Returns:
+        The input view's renderer (its rays serve other views of the same size and pose)."""
     view = ViewRenderer(state, size)
     hits = view.hits
     coverage = torch.where(hits.mask, torch.ones_like(hits.sil), hits.sil)  # 1 x S x S
-    write_image(folder / MASK_FILE, to_uint8(coverage[0].numpy()))
+    write_picture(folder / MASK_FILE, to_uint8(coverage[0].numpy()))
     _, front = render_front(hits, torch.ones_like(state.albedo[:, :1, :, : state.albedo.shape[-1] // 3]))
-    write_image(folder / MASK_FRONT_FILE, to_uint8(front[0, 0].numpy()))
+    write_picture(folder / MASK_FRONT_FILE, to_uint8(front[0, 0].numpy()))
     # drawn as radar synth draws its ground truth (black off the hard silhouette), so radar eval compares like
     # with like at the outline
-    albedo, _ = render_texture(hits, tone_map(state.albedo, state.render.gamma), inside_dim=1.0, background=0.0)
-    write_image(folder / ALBEDO_RENDERED_FILE, chw_image(albedo * hits.mask[:, None]))
+    write_picture(folder / ALBEDO_RENDERED_FILE, _on_object(hits, tone_map(state.albedo, state.render.gamma)))
     normals = torch.where(hits.mask[..., None], (hits.normal + 1) / 2, torch.zeros_like(hits.normal))
-    write_image(folder / NORMAL_RENDERED_FILE, to_uint8(normals[0].numpy()))
-    write_image(folder / RECON_FILE, view.draw(view.shading()))
+    write_picture(folder / NORMAL_RENDERED_FILE, to_uint8(normals[0].numpy()))
+    shading = view.shading()
+    write_picture(folder / RECON_FILE, view.draw(shading))
+    gamma, rho = state.render.gamma, state.rho[:, None, None, None]
+    write_picture(folder / DIFFUSE_RENDERED_FILE, _on_object(hits, tone_map(shading.diffuse, gamma)))
+    write_picture(folder / SPECULAR_RENDERED_FILE, _on_object(hits, tone_map(rho * shading.specular, gamma)))
+    return view
+
+
+def _on_object(hits: Hits, texture: torch.Tensor) -> np.ndarray:
+    """A 360 deg map (1 x C x Ht x 3Wt in [0, 1]) drawn undimmed in the view, black off the hard silhouette:
+    S x S (x C) uint8."""
+    image, _ = render_texture(hits, texture, inside_dim=1.0, background=0.0)
+    return chw_image(image * hits.mask[:, None])
 
 
 def sphere_profile() -> tuple[torch.Tensor, torch.Tensor]:
@@ -130,12 +145,23 @@ def material_sphere(state: ObjectState, size: int) -> np.ndarray:
     return view.draw(view.shading())
 
 
+def gif_frames(views: list[np.ndarray]) -> list[Image.Image]:
+    """GIF frames of H x W x 3 uint8 views: large ones (FAST_ENCODE_PIXELS) share one palette, made once by median
+    cut over all of them (Pillow's own per-frame palettes took 0.5 s of CPU for 8 frames at 512 px, this 0.1 s;
+    fast octree, 0.02 s, leaves 16 levels on a grey ramp); smaller ones are left to Pillow's per-frame palettes."""
+    if views[0].shape[0] * views[0].shape[1] < FAST_ENCODE_PIXELS:
+        return [Image.fromarray(v) for v in views]
+    height, width = views[0].shape[:2]
+    strip = Image.fromarray(np.concatenate(views, axis=1)).quantize(256, method=Image.Quantize.MEDIANCUT)
+    return [strip.crop((k * width, 0, (k + 1) * width, height)) for k in range(len(views))]
+
+
 def write_turntable(folder: Path, view: ViewRenderer, frames: int) -> None:
     """turntable.gif (looping) and turntable.png (the frames side by side): `frames` equal yaw steps."""
     shading = view.shading()
     views = [view.draw(shading, yaw_deg=360.0 * k / frames) for k in range(frames)]
-    write_image(folder / TURNTABLE_STRIP_FILE, np.concatenate(views, axis=1))
-    images = [Image.fromarray(v) for v in views]
+    write_picture(folder / TURNTABLE_STRIP_FILE, np.concatenate(views, axis=1))
+    images = gif_frames(views)
     with atomic_path(folder / TURNTABLE_GIF_FILE) as tmp:
         images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], duration=TURNTABLE_FRAME_MS,
                        loop=0)
@@ -162,15 +188,16 @@ def write_relit(folder: Path, view: ViewRenderer, envs: dict[str, np.ndarray]) -
     own = view.state.env[0].numpy()
     for name, env in envs.items():
         shading = view.shading(torch.from_numpy(match_exposure(np.asarray(env, np.float32), own))[None])
-        write_image(folder / relit_file(name), view.draw(shading))
+        write_picture(folder / relit_file(name), view.draw(shading))
 
 
 def write_renders(folder: Path, state: ObjectState, input_size: int, view_size: int, frames: int,
                   envs: dict[str, np.ndarray]) -> None:
-    """Every render of one object."""
-    write_input_view(folder, state, input_size)
-    write_image(folder / MATERIAL_SPHERE_FILE, material_sphere(state, view_size))
-    view = ViewRenderer(texture_for_size(state, view_size), view_size)
+    """Every render of one object; the turntable and relit views reuse the input view's rays at its size."""
+    input_view = write_input_view(folder, state, input_size)
+    write_picture(folder / MATERIAL_SPHERE_FILE, material_sphere(state, view_size))
+    hits = input_view.hits if view_size == input_size else None
+    view = ViewRenderer(texture_for_size(state, view_size), view_size, hits=hits)
     if frames > 0:
         write_turntable(folder, view, frames)
     write_relit(folder, view, envs)

@@ -16,6 +16,7 @@ from tqdm import tqdm
 from radar_cli.errors import InputError
 from radar_cli.evaluate import metrics
 from radar_cli.evaluate.loading import Prediction, Truth, load_prediction, load_truth
+from radar_cli.evaluate.resample import resample_prediction
 from radar_cli.results import list_results
 from radar_cli.synth import layout
 
@@ -133,9 +134,9 @@ def _stats(values: list[float]) -> dict[str, float]:
 
 
 def score_sample(sample_id: str, truth: Truth, pred: Prediction) -> SampleScore:
-    """All metrics of one object; InputError if the maps do not line up or the region is empty."""
-    if pred.mask_front.shape != truth.mask.shape:
-        raise InputError(f"{sample_id}: result maps are {pred.mask_front.shape}, ground truth {truth.mask.shape}")
+    """All metrics of one object, on the truth's pixel grid (a result of another resolution is resampled to it,
+    evaluate.resample); InputError if the maps do not line up or the region is empty."""
+    pred = resample_prediction(pred, truth.mask.shape, sample_id)
     region = truth.mask & pred.mask_front
     if not region.any():
         raise InputError(f"{sample_id}: the predicted frontal mask does not overlap the true mask")

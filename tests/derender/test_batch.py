@@ -40,7 +40,7 @@ def results(tmp_path_factory) -> Path:
     predictor = Predictor(FakeModel(), SETUP, "fake-model", "cpu")
     gallery_env = root / "gallery.hdr"  # a user environment map, any size: resampled to the model's
     cv2.imwrite(str(gallery_env), np.ones((10, 20, 3), np.float32))
-    options = DerenderOptions(out=root / "out", envs=(gallery_env,), export=EXPORT)
+    options = DerenderOptions(out=root / "out", envs=(gallery_env,), export=EXPORT, resolution=SIZE)
     summary = derender([root / "in"], predictor, options)
     assert summary.done == ["square", "wide"] and not summary.failures
     return root / "out"
