@@ -96,12 +96,15 @@ def synth(size: int, n: int, workers: int, shading_size: int) -> None:
               help="radar derender --pitch.")
 @click.option("--resolution", type=RESOLUTION, default=str(DEFAULT_RESOLUTION), show_default=True,
               help="radar derender --resolution (the benchmark's photos are 1.6 x this side).")
+@click.option("--refine", type=click.Choice(["shape", "none"]), default="shape", show_default=True,
+              help="radar derender --refine.")
 def derender(checkpoint: str | None, device: str, images: int, exports: int, batch_size: int, threads: int,
-             workers: int, albedo: str, pitch: str, resolution: Resolution) -> None:
+             workers: int, albedo: str, pitch: str, resolution: Resolution, refine: str) -> None:
     """Images per second for the network alone and for the full de-rendering with all exports; seconds per
     object and peak memory of the export at the output resolution."""
     from radar_cli.derender.benchmark import bench_derender
 
     click.echo(json.dumps(bench_derender(checkpoint, device, images, exports, batch_size, threads, workers=workers,
-                                         albedo=albedo, pitch=pitch, resolution=resolution),  # type: ignore[arg-type]
+                                         albedo=albedo, pitch=pitch, resolution=resolution,  # type: ignore[arg-type]
+                                         refine=refine),  # type: ignore[arg-type]
                           indent=2))

@@ -12,6 +12,7 @@ from radar_cli.derender.contact_sheet import contact_sheet as write_contact_shee
 from radar_cli.derender.export import MIN_VIEW_SIZE, ExportConfig
 from radar_cli.derender.inputs import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION, Resolution
 from radar_cli.derender.predictor import ALBEDO_SOURCES, PITCH_SOURCES, Predictor
+from radar_cli.derender.refine import REFINE_MODES
 
 
 class ResolutionType(click.ParamType):
@@ -55,6 +56,9 @@ RESOLUTION = ResolutionType()
 @click.option("--pitch", type=click.Choice(PITCH_SOURCES), default="network", show_default=True,
               help="network: the shape network's pitch; search: the pitch whose re-rendering best matches the "
                    "photo and its silhouette, searched over the range (slower).")
+@click.option("--refine", type=click.Choice(REFINE_MODES), default="shape", show_default=True,
+              help="shape: fit each object's shape and pose to its silhouette and rim at the output resolution, "
+                   "then re-read lighting, material and albedo there; none: the network's prediction as it is.")
 @click.option("--views", type=click.IntRange(0, 360), default=8, show_default=True, help="Turntable frames.")
 @click.option("--resolution", type=RESOLUTION, default=str(DEFAULT_RESOLUTION), show_default=True,
               help="Side in pixels of the outputs (crop, renders, the frontal third of the maps): an integer, "
@@ -74,11 +78,11 @@ RESOLUTION = ResolutionType()
 @click.option("--contact-sheet", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Also write a contact sheet PNG (input, reconstruction, albedo, relit view per object).")
 def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks: Path | None, crop: str,
-             backdrop: str, device: str, albedo: str, pitch: str, resolution: Resolution, views: int,
+             backdrop: str, device: str, albedo: str, pitch: str, refine: str, resolution: Resolution, views: int,
              view_size: int | None, envs: tuple[Path, ...],
              batch_size: int, workers: int, threads: int, overwrite: bool, contact_sheet: Path | None) -> None:
     """De-render INPUTS (image files, folders, prepared dataset folders) into --out."""
-    predictor = Predictor.from_checkpoint(checkpoint, device, albedo, pitch)  # type: ignore[arg-type]
+    predictor = Predictor.from_checkpoint(checkpoint, device, albedo, pitch, refine)  # type: ignore[arg-type]
     options = DerenderOptions(out=out, crop=crop, backdrop=backdrop, masks=masks,  # type: ignore[arg-type]
                               envs=envs, batch_size=batch_size, workers=workers, threads=threads, overwrite=overwrite,
                               export=ExportConfig(views, view_size), resolution=resolution)

@@ -183,9 +183,13 @@ def _export_all(ok: list[tuple[InputItem, Prepared]], dec: Decomposition, predic
     def one(k: int) -> Failure | None:
         item, prep = ok[k]
         try:
-            state = full_resolution_state(dec.select(k), prep, predictor.setup, predictor.albedo)
+            refined, report = predictor.refine_object(dec.select(k), prep.image, prep.photo_image,
+                                                      prep.photo_silhouette)
+            if report.status == "fallback":
+                say(f"{item.image_path}: refinement fell back to the network's prediction: {report.reason}")
+            state = full_resolution_state(refined, prep, predictor.setup, predictor.albedo)
             export_object(options.out / item.name, item, prep, state, predictor.setup, predictor.version, envs,
-                          options.export, predictor.albedo, predictor.pitch)
+                          options.export, predictor.albedo, predictor.pitch, report.record())
         except ITEM_ERRORS as e:
             return Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
         return None

@@ -16,6 +16,7 @@ from radar_cli.derender.batch import EXPORT_THREADS, DerenderOptions, derender, 
 from radar_cli.derender.export import ExportConfig, export_object
 from radar_cli.derender.inputs import DEFAULT_RESOLUTION, InputItem, Resolution, output_side, prepare
 from radar_cli.derender.predictor import AlbedoSource, PitchSource, Predictor
+from radar_cli.derender.refine import RefineMode
 from radar_cli.derender.upsample import full_resolution_state
 from radar_cli.fileio import write_image
 
@@ -86,20 +87,28 @@ def _export_cost(predictor: Predictor, photo_dir: Path, out: Path, resolution: R
     prepared = [prepare(item, setup.image_size, resolution=resolution) for item in items]
     dec = predictor.predict([p.image for p in prepared], [p.silhouette for p in prepared])
     envs = environments((), setup.render.env_height, setup.render.env_width)
-    state_s, write_s, cpu_s = [], [], []
+    refine_s, refine_cpu_s, state_s, write_s, cpu_s = [], [], [], [], []
     rss_before = _rss_mib()
     with torch_threads(EXPORT_THREADS):
         for k, (item, prep) in enumerate(zip(items, prepared)):
             start, cpu = time.perf_counter(), time.process_time()
-            state = full_resolution_state(dec.select(k), prep, setup, predictor.albedo)
+            refined, report = predictor.refine_object(dec.select(k), prep.image, prep.photo_image,
+                                                      prep.photo_silhouette)
+            refine_s.append(time.perf_counter() - start)
+            refine_cpu_s.append(time.process_time() - cpu)
+            start, cpu = time.perf_counter(), time.process_time()
+            state = full_resolution_state(refined, prep, setup, predictor.albedo)
             middle = time.perf_counter()
             export_object(out / item.name, item, prep, state, setup, predictor.version, envs, export,
-                          predictor.albedo, predictor.pitch)
+                          predictor.albedo, predictor.pitch, report.record())
             state_s.append(middle - start)
             write_s.append(time.perf_counter() - middle)
             cpu_s.append(time.process_time() - cpu)
     return {
         "resolution": sorted({p.side for p in prepared}),
+        "refine": predictor.refine,
+        "refine_seconds_per_object": round(statistics.median(refine_s), 3),
+        "refine_cpu_seconds_per_object": round(statistics.median(refine_cpu_s), 3),
         "export_state_seconds": round(statistics.median(state_s), 4),
         "export_write_seconds": round(statistics.median(write_s), 3),
         "export_seconds_per_object": round(statistics.median(s + w for s, w in zip(state_s, write_s)), 3),
@@ -113,7 +122,8 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
                    n_export: int = 4, batch_size: int = 8, threads: int = 1,
                    export: ExportConfig = ExportConfig(), predictor: Predictor | None = None,
                    workers: int = 2, albedo: AlbedoSource = "divided",
-                   pitch: PitchSource = "network", resolution: Resolution = DEFAULT_RESOLUTION) -> dict:
+                   pitch: PitchSource = "network", resolution: Resolution = DEFAULT_RESOLUTION,
+                   refine: RefineMode = "shape") -> dict:
     """Measure de-rendering speed.
 
     Args:
@@ -130,17 +140,18 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         albedo: the predictor's albedo source (`divided` adds the shading division to the network's time).
         pitch: the predictor's pitch source (`search` adds the pitch search).
         resolution: radar derender --resolution.
+        refine: radar derender --refine (timed apart from the export, one object at a time).
 
     Returns:
         {"network_images_per_s", "network_images_per_cpu_s", "full_images_per_s", "full_seconds_per_image",
-         "resolution", "export_state_seconds", "export_write_seconds", "export_seconds_per_object",
+         "resolution", "refine", "refine_seconds_per_object", "refine_cpu_seconds_per_object", "export_state_seconds", "export_write_seconds", "export_seconds_per_object",
          "export_cpu_seconds_per_object" (process CPU time: steadier than wall time on a shared machine),
          "rss_before_export_mib", "peak_rss_mib" (after the one-at-a-time exports), "full_peak_rss_mib" (after the
          full run with `workers` threads), "image_size", "photo_side", "batch_size", "n_images",
          "n_export", "device", "threads", "workers", "albedo", "pitch", "model"}; the export figures are medians
         over the objects.
     """
-    predictor = predictor or Predictor.from_checkpoint(checkpoint, device, albedo, pitch)
+    predictor = predictor or Predictor.from_checkpoint(checkpoint, device, albedo, pitch, refine)
     size = predictor.setup.image_size
     images = _photos(n_images, size)
     with torch_threads(threads):

@@ -43,7 +43,8 @@ def is_complete(folder: Path) -> bool:
 
 def export_object(folder: Path, item: InputItem, prepared: Prepared, state: ObjectState, setup: ModelSetup,
                   version: str, envs: dict[str, np.ndarray], config: ExportConfig = ExportConfig(),
-                  albedo_source: AlbedoSource = "network", pitch_source: PitchSource = "network") -> dict:
+                  albedo_source: AlbedoSource = "network", pitch_source: PitchSource = "network",
+                  refine: dict | None = None) -> dict:
     """Write all files of one object; image-space outputs at the output side N = prepared.side.
 
     Args:
@@ -56,6 +57,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         config: turntable and view settings.
         albedo_source: where the albedo came from (`network` or `divided`, see Predictor).
         pitch_source: where the pitch came from (`network` or `search`, see Predictor).
+        refine: what the per-object refinement did (derender.refine.RefineReport.record()), if it ran.
 
     Returns:
         The material.json record.
@@ -79,6 +81,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         "model": version,
         "albedo_source": albedo_source,
         "pitch_source": pitch_source,
+        **({"refine": refine} if refine is not None else {}),
         "environments": sorted(envs),
     })
     write_json(folder / MATERIAL_FILE, record)

@@ -14,6 +14,7 @@ import torch
 
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig
 from radar_cli.derender.pitch_search import search_pitch
+from radar_cli.derender.refine import REFINE_MODES, RefineMode, RefineReport, refine_object
 from radar_cli.errors import CheckpointError, InputError
 from radar_cli.model.outputs import Decomposition
 from radar_cli.model.radar import RadarModel
@@ -73,27 +74,34 @@ class Predictor:
             albedo, as the paper.
         pitch: `network`: f_S's pitch; `search`: derender.pitch_search where the silhouette is known (needs a
             RadarModel), f_S's elsewhere.
+        refine: `shape`: each object's shape and pose fitted at the output resolution, then f_L and f_A re-read
+            there (derender.refine; needs a RadarModel); `none`: the network's prediction as it is.
     """
 
     def __init__(self, model: Callable[[torch.Tensor], Decomposition], setup: ModelSetup, version: str,
                  device: torch.device | str = "cpu", albedo: AlbedoSource = "divided",
-                 pitch: PitchSource = "network"):
+                 pitch: PitchSource = "network", refine: RefineMode = "none"):
         if albedo not in ALBEDO_SOURCES:
             raise InputError(f"unknown albedo source {albedo!r} (use {' or '.join(ALBEDO_SOURCES)})")
         if pitch not in PITCH_SOURCES:
             raise InputError(f"unknown pitch source {pitch!r} (use {' or '.join(PITCH_SOURCES)})")
-        if pitch == "search" and not isinstance(model, RadarModel):
-            raise InputError("the pitch search needs a RadarModel (a checkpoint), not another callable")
+        if refine not in REFINE_MODES:
+            raise InputError(f"unknown refinement {refine!r} (use {' or '.join(REFINE_MODES)})")
+        if (pitch == "search" or refine != "none") and not isinstance(model, RadarModel):
+            raise InputError("the pitch search and the refinement need a RadarModel (a checkpoint), not another "
+                             "callable")
         self.model = model
         self.setup = setup
         self.version = version
         self.device = torch.device(device)
         self.albedo = albedo
         self.pitch = pitch
+        self.refine = refine
 
     @classmethod
     def from_checkpoint(cls, path: str | Path | None = None, device: str = "auto",
-                        albedo: AlbedoSource = "divided", pitch: PitchSource = "network") -> "Predictor":
+                        albedo: AlbedoSource = "divided", pitch: PitchSource = "network",
+                        refine: RefineMode = "none") -> "Predictor":
         """Load a checkpoint (default: the bundled model); CheckpointError if it is missing or does not fit."""
         path = Path(path) if path is not None else bundled_checkpoint()
         if not path.is_file():
@@ -107,7 +115,7 @@ class Predictor:
         model.eval()
         cfg = model.config
         setup = ModelSetup(cfg.render, cfg.camera, cfg.geometry)
-        return cls(model, setup, f"{path.name}#{_short_hash(path)}", dev, albedo, pitch)
+        return cls(model, setup, f"{path.name}#{_short_hash(path)}", dev, albedo, pitch, refine)
 
     @torch.no_grad()
     def predict(self, images: list[np.ndarray],
@@ -140,6 +148,26 @@ class Predictor:
                                     camera, coverage)
             dec = dataclasses.replace(dec, albedo=albedo)
         return dec.detach().to("cpu")
+
+    def refine_object(self, dec: Decomposition, image: np.ndarray, crop: np.ndarray,
+                      silhouette: np.ndarray | None) -> tuple[Decomposition, RefineReport]:
+        """One object's prediction refined at the output resolution (derender.refine), or kept.
+
+        Args:
+            dec: its Decomposition (batch of one, CPU). image: the S x S x 3 uint8 network input.
+            crop: N x N x 3 uint8 at the output side; silhouette: N x N bool, or None.
+
+        Returns:
+            (the Decomposition to export, what the refinement did).
+        """
+        if self.refine == "none":
+            return dec, RefineReport("off", "--refine none", crop.shape[0])
+        if crop.shape[0] <= self.setup.image_size:
+            return dec, RefineReport("off", "the output is at the network's size", crop.shape[0])
+        batch = torch.from_numpy(image).permute(2, 0, 1)[None].to(self.device, torch.float32) / 255.0
+        refined, report = refine_object(self.model, batch, dec.to(self.device), crop, silhouette,
+                                        self.setup.camera)
+        return (dec if refined is None else refined.to("cpu")), report
 
     def _search_pitch(self, batch: torch.Tensor, silhouettes: list[np.ndarray | None],
                       dec: Decomposition) -> Decomposition:

@@ -1,0 +1,308 @@
+"""Shape and pose refined against the photograph at the crop's resolution (radar's addition, `radar derender
+--refine`; docs/refinement.md).
+
+The silhouette alone does not fix pitch: a profile whose rows bend near the rim and the base draws the arcs that
+another pitch draws. So pitch is searched over a grid, and at each candidate the rest follows from the outline
+in closed form (the axis from the rows' midpoints, the profile from the rows' widths, height and vertical offset
+from the outline's top and bottom); each candidate is scored by how well it draws the outline plus how much its
+profile has to bend. Where the open mouth is visible, the rim's front arc is an edge in the image (the inside is
+darker than the outer wall below the lip) and its contrast picks the pitch; a fine grid then narrows it, and the
+profile, height, roll and offset are polished by L-BFGS at full resolution with the pitch held.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+
+from radar_cli.config import CameraConfig
+from radar_cli.sor.outline import Outline, disc_conics, mask_outline, outline, roots
+from radar_cli.sor.pose import rotation_matrix, translation
+
+
+@dataclass(frozen=True)
+class ShapeFitConfig:
+    """How the shape and pose are fitted (weights chosen on 24 vases of `radar synth --size 512 --seed 5`;
+    docs/refinement.md).
+
+    Attributes:
+        rows: profile rows fitted.
+        grid_size: outline resolution of the pitch grids (px).
+        pitch_max: the grids cover 0..pitch_max degrees.
+        coarse_step, fine_step: the pitch grids (the fine one spans +- coarse_step round the coarse pick).
+        roughness_weight: the profile's bending (sum of squared second differences x 1e3, at 64 rows).
+        basin: the lip may pick any candidate whose outline score is within this of the best.
+        lip_contrast: the lip is trusted where its contrast (grey levels 0..1) exceeds this.
+        lip_offset_px, fine_lip_offset_px: the lip's two sides are sampled this far above and below the arc (px
+            at 512 px), on the coarse grid (wide: finds the lip) and on the fine one (narrow: places it).
+        width_rounds: rounds of correct_widths at full resolution after the search.
+        polish_steps: Adam steps at grid_size, then at full resolution, pitch held.
+        polish_lr: their step (radii, height and offsets in hundredths of r_max, roll in degrees).
+        placement_iterations: closed-form rounds of profile, height and vertical offset per candidate.
+    """
+
+    rows: int = 64
+    grid_size: int = 256
+    pitch_max: float = 25.0
+    coarse_step: float = 0.5
+    fine_step: float = 0.1
+    roughness_weight: float = 0.5
+    basin: float = 3.0
+    lip_contrast: float = 0.1
+    lip_offset_px: float = 2.0
+    fine_lip_offset_px: float = 1.0
+    width_rounds: int = 3
+    polish_steps: tuple[int, int] = (40, 10)
+    polish_lr: float = 0.05
+    placement_iterations: int = 3
+
+
+@dataclass(frozen=True)
+class ShapeFit:
+    """A fitted shape and pose, batch of one.
+
+    Attributes:
+        radius: 1 x rows radius column (fractions of r_max); height: 1; pose: 1 x 4 (pitch, roll, tx, ty).
+        outline_error: mean distance in px (at the fitted resolution) between the fitted and the target outline.
+        pitch_cue: `lip` if the rim's front arc picked the pitch, else `outline`.
+    """
+
+    radius: torch.Tensor
+    height: torch.Tensor
+    pose: torch.Tensor
+    outline_error: float
+    pitch_cue: str
+
+
+def huber(d: torch.Tensor, delta: float = 1.0) -> torch.Tensor:
+    a = d.abs()
+    return torch.where(a < delta, 0.5 * a * a, delta * (a - 0.5 * delta))
+
+
+def outline_score(model: Outline, target: Outline, absolute: bool = False) -> torch.Tensor:
+    """B scores: mean Huber (1 px) distance between a batch of outlines and one target over the rows and columns
+    both cover, plus 2 per row or column only one of them covers (absolute=True: the mean |distance| instead)."""
+    total, count = 0.0, 0
+    for name in ("left", "right", "top", "bottom"):
+        a = getattr(model, name)
+        b = getattr(target, name).expand_as(a)
+        both = ~(a.isnan() | b.isnan())
+        diff = torch.where(both, a - b, torch.zeros_like(a))
+        total = total + (diff.abs() if absolute else huber(diff)).sum(1)
+        if not absolute:
+            total = total + 2.0 * (a.isnan() ^ b.isnan()).sum(1)
+        count = count + both.sum(1)
+    return total / count.clamp_min(1)
+
+
+def roughness(radius: torch.Tensor) -> torch.Tensor:
+    """B bending energies of B x L profiles: sum of squared second differences, x 1e3, scaled to 64 rows."""
+    d2 = radius[:, 2:] - 2 * radius[:, 1:-1] + radius[:, :-2]
+    return (d2**2).sum(1) * 1e3 * (radius.shape[1] / 64) ** 3
+
+
+def downsample(mask: np.ndarray, size: int) -> np.ndarray:
+    """An H x H coverage map (bool or float) area-averaged to size x size (float64)."""
+    m = torch.from_numpy(np.asarray(mask, np.float32))[None, None]
+    return F.interpolate(m, size=(size, size), mode="area")[0, 0].double().numpy()
+
+
+def _tan(camera: CameraConfig) -> float:
+    return math.tan(math.radians(camera.fov_deg) / 2.0)
+
+
+def axis_from_outline(target: Outline, size: int, camera: CameraConfig) -> tuple[float, float]:
+    """(roll deg, tx) of the line through the rows' midpoints (least squares)."""
+    rows = torch.nonzero(~target.left[0].isnan()).flatten()
+    if len(rows) < 2:
+        raise ValueError("the silhouette covers fewer than two rows")
+    mid = ((target.left[0] + target.right[0]) / 2)[rows]
+    a = torch.stack([rows.double(), torch.ones(len(rows), dtype=torch.float64)], 1)
+    slope, intercept = torch.linalg.lstsq(a, mid[:, None]).solution[:, 0].tolist()
+    centre_x = slope * (size / 2 - 0.5) + intercept
+    tx = ((centre_x + 0.5) * 2 / size - 1) * _tan(camera) * camera.distance / camera.r_max
+    return math.degrees(math.atan(slope)), tx
+
+
+def _disc_centres(height: torch.Tensor, pose: torch.Tensor, rows: int, camera: CameraConfig) -> torch.Tensor:
+    """B x rows x 3 camera-space centres of the profile rows' discs."""
+    v = torch.linspace(-1, 1, rows, dtype=torch.float64)
+    y = -v[None] * height[:, None] * camera.r_max
+    rot, shift = rotation_matrix(pose), translation(pose, camera)
+    return y[..., None] * rot[:, None, :, 1] + shift[:, None, :]
+
+
+def profile_from_widths(target: Outline, height: torch.Tensor, pose: torch.Tensor, rows: int, size: int,
+                        camera: CameraConfig) -> torch.Tensor:
+    """B x rows radius column read off the target's row widths: each disc's radius is the half-width of the
+    image row its centre projects to, scaled back by its depth (exact for a cylinder seen side on)."""
+    valid = torch.nonzero(~target.left[0].isnan()).flatten()
+    half = ((target.right[0] - target.left[0]) / 2)[valid]
+    centre = _disc_centres(height, pose, rows, camera)
+    tan = _tan(camera)
+    row = (1 - centre[..., 1] / centre[..., 2] / tan) * size / 2 - 0.5
+    width = np.interp(row.numpy().ravel(), valid.numpy(), half.numpy()).reshape(row.shape)
+    radius = torch.from_numpy(width) * (2 / size) * centre[..., 2] * tan / camera.r_max
+    return radius.clamp(0.05, 0.9)
+
+
+def closed_form(target: Outline, size: int, pitches: torch.Tensor, roll: float, tx: float,
+                config: ShapeFitConfig, camera: CameraConfig) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """The shape at each candidate pitch: profile from the widths, then height and vertical offset moved so that
+    the outline's top and bottom rows match the target's (a few rounds).
+
+    Returns:
+        (radius B x rows, height B, pose B x 4), float64.
+    """
+    batch = len(pitches)
+    pose = torch.zeros(batch, 4, dtype=torch.float64)
+    pose[:, 0], pose[:, 1], pose[:, 2] = pitches, roll, tx
+    height = torch.full((batch,), 0.7, dtype=torch.float64)
+    top, bottom = np.nanmin(target.top[0].numpy()), np.nanmax(target.bottom[0].numpy())
+    unit = 2.0 / size  # r_max fractions per pixel at the object's distance
+    for _ in range(config.placement_iterations):
+        radius = profile_from_widths(target, height, pose, config.rows, size, camera)
+        drawn = outline(radius, height, pose, size, camera)
+        d_top = top - torch.from_numpy(np.nanmin(drawn.top.numpy(), 1))
+        d_bottom = bottom - torch.from_numpy(np.nanmax(drawn.bottom.numpy(), 1))
+        height = (height + (d_bottom - d_top) / 2 * unit / torch.cos(torch.deg2rad(pose[:, 0]))).clamp(0.3, 1.2)
+        pose[:, 3] = pose[:, 3] - (d_top + d_bottom) / 2 * unit
+    return profile_from_widths(target, height, pose, config.rows, size, camera), height, pose
+
+
+def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
+                 offset_px: float, camera: CameraConfig, samples: int = 512) -> torch.Tensor:
+    """B contrasts of the rim's front arc: the mean grey level just below it (outer wall) minus just above it
+    (the inside, seen through the mouth), over the middle 80% of the arc.
+
+    Args:
+        grey: 1 x 1 x S x S grey image in [0, 1]. radius: B x L; height: B; pose: B x 4.
+
+    Returns:
+        B contrasts (0 where the rim's ellipse has no width, i.e. seen edge on).
+    """
+    q = disc_conics(radius, height, pose, 2, camera)[:, 0]  # B x 3 x 3, the top disc
+    x = torch.linspace(-1, 1, samples, dtype=torch.float64)
+    # the rim's front arc: per column, the lower root y of the top disc's conic (y up)
+    front, _ = roots(q[:, 1, 1, None].expand(-1, samples), q[:, 0, 1, None] * x + q[:, 1, 2, None],
+                     q[:, 0, 0, None] * x * x + 2 * q[:, 0, 2, None] * x + q[:, 2, 2, None])  # B x N
+    covered = ~front.isnan()
+    lo = torch.where(covered, x, torch.full_like(front, math.inf)).amin(1, keepdim=True)
+    hi = torch.where(covered, x, torch.full_like(front, -math.inf)).amax(1, keepdim=True)
+    use = covered & ((x - (lo + hi) / 2).abs() <= 0.4 * (hi - lo))  # B x N
+    step = offset_px * 2 / 512
+    y = torch.nan_to_num(front)
+    points = torch.stack([torch.stack([x.expand_as(y), -(y + step)], -1),  # above the arc (inside); rows down
+                          torch.stack([x.expand_as(y), -(y - step)], -1)], 1)  # below the arc (outer wall)
+    values = F.grid_sample(grey.expand(len(y), -1, -1, -1), points.float(), align_corners=False)[:, 0]  # B x 2 x N
+    diff = (values[:, 1] - values[:, 0]).double() * use
+    return diff.sum(1) / use.sum(1).clamp_min(1)
+
+
+def _search(target: Outline, grey: torch.Tensor, size: int, pitches: torch.Tensor, roll: float, tx: float,
+            config: ShapeFitConfig, camera: CameraConfig, lip_offset_px: float):
+    """Score a grid of candidate pitches: (shapes, outline + bending scores B, lip contrasts B)."""
+    radius, height, pose = closed_form(target, size, pitches, roll, tx, config, camera)
+    score = outline_score(outline(radius, height, pose, size, camera), target)
+    score = score + config.roughness_weight * roughness(radius)
+    return (radius, height, pose), score, lip_contrast(grey, radius, height, pose, lip_offset_px, camera)
+
+
+def _pick(score: torch.Tensor, contrast: torch.Tensor, config: ShapeFitConfig) -> tuple[int, str]:
+    """The candidate with the strongest lip inside the outline's basin if that lip is strong enough, else the
+    best outline score."""
+    lips = torch.where(score <= score.min() + config.basin, contrast, torch.full_like(contrast, -math.inf))
+    if float(lips.max()) > config.lip_contrast:
+        return int(lips.argmax()), "lip"
+    return int(score.argmin()), "outline"
+
+
+def search_pitch(target: Outline, grey: torch.Tensor, size: int, config: ShapeFitConfig,
+                 camera: CameraConfig) -> tuple[tuple[torch.Tensor, ...], str]:
+    """Coarse then fine pitch grids; the fine one keeps the coarse one's cue. Returns ((radius, height, pose)
+    of the chosen candidate, batch of one, float64; the cue)."""
+    roll, tx = axis_from_outline(target, size, camera)
+    coarse = torch.arange(0.0, config.pitch_max + 1e-6, config.coarse_step, dtype=torch.float64)
+    _, score, contrast = _search(target, grey, size, coarse, roll, tx, config, camera, config.lip_offset_px)
+    best, cue = _pick(score, contrast, config)
+    centre = float(coarse[best])
+    fine = torch.arange(centre - config.coarse_step, centre + config.coarse_step + 1e-6, config.fine_step,
+                        dtype=torch.float64).clamp(0.0, config.pitch_max)
+    shapes, score, contrast = _search(target, grey, size, fine, roll, tx, config, camera, config.fine_lip_offset_px)
+    best = int(contrast.argmax()) if cue == "lip" else int(score.argmin())
+    return tuple(t[best : best + 1] for t in shapes), cue
+
+
+def polish(target: Outline, size: int, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
+           steps: int, config: ShapeFitConfig, camera: CameraConfig) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Adam on the profile, height, roll and offsets against the outline (plus the bending term), pitch held.
+    (L-BFGS's line search stalls on the outline's kinks.) Parameters are scaled to comparable steps: radii and
+    offsets x 100, roll in degrees."""
+    rows = radius.shape[1]
+    x = torch.cat([radius * 100, height[:, None] * 100, pose[:, 1:2], pose[:, 2:] * 100], 1).detach()
+    x.requires_grad_(True)
+    pitch = pose[:, :1].detach()
+
+    def unpack(v: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        tail = torch.cat([pitch, v[:, rows + 1 : rows + 2], v[:, rows + 2 :] / 100], 1)
+        return (v[:, :rows] / 100).clamp(0.02, 1.0), v[:, rows] / 100, tail
+
+    opt = torch.optim.Adam([x], lr=config.polish_lr)
+    for _ in range(steps):
+        opt.zero_grad()
+        r, h, p = unpack(x)
+        loss = (outline_score(outline(r, h, p, size, camera), target) + config.roughness_weight * roughness(r)).sum()
+        loss.backward()
+        opt.step()
+    return unpack(x.detach())
+
+
+def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = ShapeFitConfig(),
+              camera: CameraConfig = CameraConfig()) -> ShapeFit:
+    """Fit shape and pose to one object's silhouette and image.
+
+    Args:
+        mask: N x N silhouette (bool or coverage in [0, 1]) of the crop.
+        grey: N x N grey image in [0, 1] of the same crop (the lip's contrast).
+        config: the fit's settings. camera: the fixed camera.
+
+    Returns:
+        ShapeFit at resolution N (polished at N, searched at min(N, config.grid_size)).
+    """
+    size = mask.shape[0]
+    grid = min(size, config.grid_size)
+    coarse_target = mask_outline(downsample(mask, grid))
+    grey_t = torch.from_numpy(np.asarray(grey, np.float32))[None, None]
+    (radius, height, pose), cue = search_pitch(coarse_target, grey_t, grid, config, camera)
+    target = mask_outline(np.asarray(mask, np.float64))
+    radius = correct_widths(target, size, radius, height, pose, config.width_rounds, camera)
+    for level, steps in zip((grid, size), config.polish_steps):
+        level_target = coarse_target if level == grid else target
+        radius, height, pose = polish(level_target, level, radius, height, pose, steps, config, camera)
+    error = float(outline_score(outline(radius, height, pose, size, camera), target, absolute=True)[0])
+    return ShapeFit(radius.float(), height.float(), pose.float(), error, cue)
+
+
+def correct_widths(target: Outline, size: int, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
+                   rounds: int, camera: CameraConfig) -> torch.Tensor:
+    """The profile rescaled row by row so that the drawn outline's width matches the target's at the image row
+    of each disc's centre (this takes in the limb's offset on sloping walls and the perspective, which
+    profile_from_widths ignores). B x L."""
+    target_width = (target.right - target.left)[0].numpy()
+    tan = _tan(camera)
+    for _ in range(rounds):
+        drawn = outline(radius, height, pose, size, camera)
+        width = (drawn.right - drawn.left).numpy()  # B x S
+        centre = _disc_centres(height, pose, radius.shape[1], camera)
+        row = ((1 - centre[..., 1] / centre[..., 2] / tan) * size / 2 - 0.5).numpy()
+        ratio = target_width[None] / np.maximum(width, 1.0)
+        for b in range(len(radius)):
+            ok = np.isfinite(ratio[b]) & (width[b] >= 1.0)
+            if ok.sum() >= 2:
+                scale = np.interp(row[b], np.nonzero(ok)[0], ratio[b][ok])
+                radius[b] = (radius[b] * torch.from_numpy(np.clip(scale, 0.5, 2.0))).clamp(0.05, 0.9)
+    return radius

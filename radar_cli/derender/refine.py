@@ -1,0 +1,110 @@
+"""Per-object refinement after the network (`radar derender --refine shape`, the default): the shape and pose
+fitted to the silhouette and the rim at the crop's resolution (derender.fit_shape), then the lighting, material
+and albedo networks re-read at the fitted shape. A fit that fails, or draws the outline worse than the network's
+prediction, falls back to the network's and says why (material.json `refine`, summary.csv)."""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+import torch
+
+from radar_cli.config import CameraConfig
+from radar_cli.derender.fit_shape import ShapeFitConfig, fit_shape, outline_score
+from radar_cli.model.outputs import Decomposition
+from radar_cli.render.raycast import cast_rays
+from radar_cli.sor.outline import mask_outline, outline
+
+RefineMode = Literal["shape", "none"]
+REFINE_MODES: tuple[RefineMode, ...] = ("shape", "none")
+FIT_ERRORS = (ValueError, RuntimeError, FloatingPointError)
+
+
+@dataclass(frozen=True)
+class RefineReport:
+    """What the refinement of one object did.
+
+    Attributes:
+        status: `refined`, `fallback` (the network's prediction kept, see reason) or `off` (--refine none).
+        reason: why it fell back ('' if it did not).
+        resolution: side of the crop the fit ran at (px).
+        pitch_cue: `lip` (the rim's front arc) or `outline` (the silhouette alone) picked the pitch.
+        outline_px: mean distance between the drawn and the located outline (px at `resolution`), refined /
+            network.
+        iou: silhouette IoU against the located one at `resolution`, refined / network.
+        seconds: time the fit took.
+    """
+
+    status: str
+    reason: str = ""
+    resolution: int = 0
+    pitch_cue: str = ""
+    outline_px: tuple[float, float] = (float("nan"), float("nan"))
+    iou: tuple[float, float] = (float("nan"), float("nan"))
+    seconds: float = 0.0
+
+    def record(self) -> dict:
+        """material.json's `refine` entry (NaN written as null)."""
+        clean = lambda v: None if v != v else round(v, 4)  # noqa: E731
+        return {"status": self.status, "reason": self.reason, "resolution": self.resolution,
+                "pitch_cue": self.pitch_cue, "outline_px": {"refined": clean(self.outline_px[0]),
+                                                            "network": clean(self.outline_px[1])},
+                "silhouette_iou": {"refined": clean(self.iou[0]), "network": clean(self.iou[1])},
+                "seconds": round(self.seconds, 3)}
+
+
+def silhouette_iou(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, mask: np.ndarray,
+                   camera: CameraConfig) -> float:
+    """IoU of the ray-cast silhouette (N x N, hard) with an N x N bool mask."""
+    with torch.no_grad():
+        drawn = cast_rays(radius.float(), height.float(), pose.float(), mask.shape[0], camera, 1.0,
+                          soft_outside=False).mask[0].numpy()
+    union = (drawn | mask).sum()
+    return float((drawn & mask).sum() / union) if union else 0.0
+
+
+def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarray, silhouette: np.ndarray | None,
+                  camera: CameraConfig, config: ShapeFitConfig = ShapeFitConfig()) -> tuple[Decomposition | None,
+                                                                                             RefineReport]:
+    """Refine one object's prediction.
+
+    Args:
+        model: the RadarModel (its read_appearance re-reads lighting, material and albedo at a shape).
+        image: 1 x 3 x S x S network input in [0, 1]. dec: its Decomposition (batch of one, CPU).
+        crop: N x N x 3 uint8 crop at the output resolution; silhouette: N x N bool located silhouette (None:
+            nothing to fit, the network's prediction is kept).
+        camera: the fixed camera. config: the fit's settings.
+
+    Returns:
+        (the refined Decomposition with config.rows profile rows, or None to keep `dec`; the report).
+    """
+    size = crop.shape[0]
+    if silhouette is None:
+        return None, RefineReport("fallback", "no silhouette to fit (--crop none without --masks)", size)
+    start = time.perf_counter()
+    network_iou = silhouette_iou(dec.radius, dec.height, dec.pose, silhouette, camera)
+    target = mask_outline(silhouette)
+    network_px = float(outline_score(outline(dec.radius, dec.height, dec.pose, size, camera), target,
+                                     absolute=True)[0])
+    grey = crop.astype(np.float32).mean(axis=2) / 255.0
+    try:
+        fit = fit_shape(silhouette, grey, config, camera)
+        refined_iou = silhouette_iou(fit.radius, fit.height, fit.pose, silhouette, camera)
+    except FIT_ERRORS as e:
+        return None, RefineReport("fallback", f"the fit failed ({type(e).__name__}: {e})", size,
+                                 outline_px=(float("nan"), network_px), iou=(float("nan"), network_iou),
+                                 seconds=time.perf_counter() - start)
+    report = RefineReport("refined", "", size, fit.pitch_cue, (fit.outline_error, network_px),
+                          (refined_iou, network_iou), time.perf_counter() - start)
+    if not refined_iou >= network_iou:
+        return None, dataclasses.replace(report, status="fallback",
+                                        reason=f"the fit drew the silhouette worse (IoU {refined_iou:.3f} "
+                                               f"against the network's {network_iou:.3f})")
+    device = image.device
+    with torch.no_grad():
+        refined = model.read_appearance(image, fit.radius.to(device), fit.height.to(device), fit.pose.to(device))
+    return refined.detach(), report
