@@ -26,6 +26,7 @@ from radar_cli.derender.predictor import Predictor
 from radar_cli.derender.report import write_report
 from radar_cli.derender.shard import Shard, read_share_failures, write_share_failures
 from radar_cli.errors import InputError, RadarError
+from radar_cli.fileio import remove_stale_temps
 from radar_cli.model.outputs import Decomposition
 
 T, R = TypeVar("T"), TypeVar("R")
@@ -120,6 +121,7 @@ def _pending(batch: list[InputItem], out: Path, overwrite: bool, summary: BatchS
             say(f"{item.name}: skipped, {out / item.name} exists (use --overwrite to redo it)")
         else:
             todo.add(item.name)
+            remove_stale_temps(out / item.name)  # what a killed run was writing
     return todo
 
 

@@ -75,6 +75,20 @@ def test_shares_together_equal_one_process(photos: Path, tmp_path: Path) -> None
     assert len(failures) == 2 and "notes.txt" in failures[1]  # the input error once, though both shares saw it
 
 
+def test_rerun_redoes_a_half_written_object_to_the_same_bytes(photos: Path, tmp_path: Path) -> None:
+    """What a killed process leaves (no material.json, a temporary file mid-rename) is redone and cleaned."""
+    predictor = Predictor(FakeModel(), SETUP, "fake-model", "cpu")
+    options = DerenderOptions(out=tmp_path / "out", batch_size=3, export=EXPORT)
+    derender([photos], predictor, options)
+    before = object_files(tmp_path / "out")
+    folder = tmp_path / "out" / "vase_04"
+    (folder / "material.json").unlink()
+    (folder / ".albedo.png.x1y2.tmp.png").write_bytes(b"half")
+    summary = derender([photos], predictor, options)
+    assert summary.done == ["vase_04"] and len(summary.skipped) == N_INPUTS - 1
+    assert object_files(tmp_path / "out") == before
+
+
 def test_cli_rejects_a_bad_shard(photos: Path, tmp_path: Path) -> None:
     result = CliRunner().invoke(cli, ["derender", str(photos), "--out", str(tmp_path / "o"), "--shard", "2/2"])
     assert result.exit_code == 2 and "--shard" in result.output

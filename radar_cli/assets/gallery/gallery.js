@@ -167,7 +167,7 @@
 
   function pictures(o) {
     const figs = [["input.png", "input"], ["recon.png", "reconstruction"], ["albedo_rendered.png", "albedo"],
-      ["normal_rendered.png", "normals"], ["material_sphere.png", "material"], ["env_map.png", "recovered lighting"]];
+      ["normal_rendered.png", "normals"], ["material_sphere.png", "material"], ["env_map.png", "recovered lighting"], ["turntable.gif", "turntable"]];
     if (o.appendages) figs.push(["appendages.png", "appendages"]);
     for (const e of o.relit) figs.push(["relit_" + e + ".png", "relit: " + e]);
     const box = el("div", { class: "pictures" });
