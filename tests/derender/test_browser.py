@@ -64,8 +64,14 @@ def browser():
 
 @pytest.fixture(scope="module")
 def results(tmp_path_factory) -> Path:
-    """The example photos de-rendered by the bundled model; one object marked for review by a quality record."""
+    """The example photos de-rendered by the bundled model; one object marked for review by a quality record and
+    attributed as if its photo came from `radar masks` (a meta.json beside it)."""
     out = tmp_path_factory.mktemp("browser") / "results"
+    sample = out.parent / "prepared" / "test" / "met_1"
+    sample.mkdir(parents=True)
+    (sample / "meta.json").write_text(json.dumps({"attribution": {
+        "object_id": 1, "title": "Storage jar", "credit_line": "Rogers Fund, 1917", "licence": "CC0",
+        "object_url": "https://www.metmuseum.org/art/collection/search/1"}}))
     options = DerenderOptions(out=out, export=ExportConfig(views=4, view_size=128))
     summary = derender([REPO / "examples"], Predictor.from_checkpoint(device="cpu"), options)
     assert len(summary.done) == 6 and not summary.failures
@@ -73,6 +79,7 @@ def results(tmp_path_factory) -> Path:
     material["quality"] = {"status": "review", "reasons": ["symmetry 0.61 < 0.8"], "silhouette_iou": 0.9,
                            "symmetry": 0.61, "recon_psnr": 21.0, "appendage_fraction": 0.0, "cut_edges": [],
                            "frame_coverage": 0.5}
+    material["source"] = str(sample / "image.png")
     (out / "synthetic_vase_3" / "material.json").write_text(json.dumps(material))
     write_report(out, [])
     return out
@@ -132,6 +139,15 @@ def test_overview_and_3d_view_served(browser, served: str, results: Path) -> Non
         pitches, key=lambda k: -pitches[k])
     page.fill("#search", "vase_2")
     assert page.eval_on_selector_all(".card", "cards => cards.map(c => c.dataset.id)") == ["synthetic_vase_2"]
+    page.fill("#search", "storage")  # by the catalogue's title
+    assert page.eval_on_selector_all(".card", "cards => cards.map(c => c.dataset.id)") == ["synthetic_vase_3"]
+    page.click(".card[data-id='synthetic_vase_3']")
+    assert "Rogers Fund, 1917 · CC0" in page.inner_text(".attribution")
+    link = page.locator(".attribution a")
+    assert link.get_attribute("href") == "https://www.metmuseum.org/art/collection/search/1"
+    page.wait_for_function("document.querySelector('model-viewer') && document.querySelector('model-viewer').loaded",
+                           timeout=60000)
+    page.click("text=← all objects")
     page.fill("#search", "")
 
     page.click(f".card[data-id='{OBJECT}']")
@@ -175,13 +191,16 @@ def test_opened_from_disk(browser, results: Path) -> None:
 
 
 def synthetic_collection(results: Path, root: Path, n: int) -> None:
-    """`n` object folders copied from one de-rendered object (material.json with a made-up quality record)."""
+    """`n` object folders holding what the overview reads, from one de-rendered object (material.json with a
+    made-up quality record, the thumbnail, the viewer's lighting)."""
     source = results / OBJECT
     material = json.loads((source / "material.json").read_text())
     rng = np.random.default_rng(0)
     for k in range(n):
         folder = root / f"obj_{k:04d}"
-        shutil.copytree(source, folder)
+        folder.mkdir()
+        for name in (THUMBNAIL_FILE, "env_viewer.hdr", "relit_studio.png"):
+            shutil.copyfile(source / name, folder / name)
         status = ("ok", "review", "failed")[k % 7 % 3]
         material["quality"] = {"status": status, "reasons": [] if status == "ok" else ["made up"],
                                "silhouette_iou": float(rng.uniform(0.5, 1)), "symmetry": float(rng.uniform(0.5, 1)),
