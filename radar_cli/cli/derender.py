@@ -53,7 +53,8 @@ from radar_cli.derender.shard import Shard, derender_sharded
               help="Also write a contact sheet PNG (input, reconstruction, albedo, relit view per object).")
 def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks: Path | None, crop: str,
              backdrop: str, device: str, albedo: str, pitch: str, views: int, view_size: int, envs: tuple[Path, ...],
-             batch_size: int, workers: int, threads: int, overwrite: bool, shard: str, contact_sheet: Path | None) -> None:
+             batch_size: int, workers: int, threads: int, overwrite: bool, shard: str,
+             contact_sheet: Path | None) -> None:
     """De-render INPUTS (image files, folders, prepared dataset folders) into --out.
 
     On many processes or machines: `torchrun --nnodes N --nproc_per_node P -m radar_cli derender ...` (rank 0

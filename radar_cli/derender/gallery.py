@@ -3,12 +3,14 @@ into RESULTS/.gallery/, one data file describing every object, a small thumbnail
 files the viewer relights with (each object's recovered environment and the built-in ones).
 
 The page needs no network: the viewer is Google's <model-viewer> (vendored, see radar_cli/assets/gallery/).
-Browsers refuse a page opened from disk (file://) the mesh and HDR fetches WebGL needs, so the 3D view works
-through `radar serve RESULTS` (or any static HTTP server); from disk the page shows the same objects as pictures.
+Browsers refuse a page opened from disk (file://) the mesh and HDR fetches WebGL needs: the 3D view works through
+`radar serve RESULTS` (or any static HTTP server), and from disk once the user picks the object's mesh.glb (files
+chosen by the user may be read); the built-in lighting is in a script for that case.
 """
 
 from __future__ import annotations
 
+import base64
 import json
 import math
 import shutil
@@ -26,6 +28,7 @@ ASSETS = Path(__file__).resolve().parents[1] / "assets" / "gallery"
 GALLERY_DIR = ".gallery"  # RESULTS/.gallery/: page code, viewer, data, built-in environments
 DATA_FILE = "data.js"  # a script, not JSON: a page opened from disk may run scripts but not fetch files
 ENV_DIR = "env"
+ENV_SCRIPT = "env.js"  # the built-in environments' .hdr files as base64, for a page opened from disk
 THUMBNAIL_FILE = "thumbnail.png"  # per object: input | reconstruction, THUMB_SIDE px each
 VIEWER_ENV_FILE = "env_viewer.hdr"  # per object: its recovered lighting in the viewer's convention
 APPENDAGES_FILE = "appendages.png"  # per object, written by the quality checks when present
@@ -120,9 +123,11 @@ def attribution(source: str, catalogs: dict[Path, sqlite3.Connection]) -> dict |
                     if db is None:
                         db = catalogs[data_dir] = sqlite3.connect(f"file:{data_dir / CATALOG_NAME}?mode=ro", uri=True)
                     row = db.execute(
-                        "SELECT object_id, title, credit_line, licence, object_url FROM objects WHERE image_path = ?",
+                        "SELECT object_id, title, credit_line, licence, object_url FROM objects "
+                        "WHERE image_path = ?",
                         (str(path.relative_to(data_dir)),)).fetchone()
-                    found = dict(zip(("object_id", "title", "credit_line", "licence", "object_url"), row)) if row else None
+                    keys = ("object_id", "title", "credit_line", "licence", "object_url")
+                    found = dict(zip(keys, row)) if row else None
                     break
     except (OSError, ValueError, AttributeError, sqlite3.Error):
         return None
@@ -166,12 +171,18 @@ def _copy_page_files(target: Path) -> None:
             shutil.copyfile(src, tmp)
 
 
-def _write_builtin_environments(target: Path) -> list[str]:
-    """RESULTS/.gallery/env/<name>.hdr for every built-in environment (written once); their names."""
+def _write_builtin_environments(gallery: Path) -> list[str]:
+    """RESULTS/.gallery/env/<name>.hdr for every built-in environment, and the same files in env.js for a page
+    opened from disk (which may run a script but not fetch a file); written once. Returns their names."""
     envs = builtin_environments(*VIEWER_ENV_SIZE)
+    target = gallery / ENV_DIR
     for name, env in envs.items():
         if not (target / f"{name}.hdr").is_file():
             write_hdr(target / f"{name}.hdr", viewer_environment(env))
+    if not (gallery / ENV_SCRIPT).is_file():
+        files = {name: base64.b64encode((target / f"{name}.hdr").read_bytes()).decode("ascii")
+                 for name in sorted(envs)}
+        write_text(gallery / ENV_SCRIPT, "window.RADAR_ENVS = " + json.dumps(files) + ";\n")
     return sorted(envs)
 
 
@@ -179,7 +190,7 @@ def write_gallery(root: Path, records: list[tuple[str, dict]], n_failed: int) ->
     """index.html and RESULTS/.gallery/ for the complete objects `records` (name, material.json record)."""
     gallery = root / GALLERY_DIR
     _copy_page_files(gallery)
-    builtins = _write_builtin_environments(gallery / ENV_DIR)
+    builtins = _write_builtin_environments(gallery)
     entries, catalogs = [], {}
     try:
         for name, rec in records:

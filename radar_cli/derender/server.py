@@ -15,7 +15,8 @@ from radar_cli.results import INDEX_FILE
 HOST = "127.0.0.1"  # local only: the results are never offered to the network
 MIME_TYPES = {".glb": "model/gltf-binary", ".gltf": "model/gltf+json", ".hdr": "image/vnd.radiance",
               ".js": "text/javascript", ".csv": "text/csv; charset=utf-8", ".json": "application/json",
-              ".obj": "text/plain; charset=utf-8", ".mtl": "text/plain; charset=utf-8", ".npy": "application/octet-stream"}
+              ".obj": "text/plain; charset=utf-8", ".mtl": "text/plain; charset=utf-8",
+              ".npy": "application/octet-stream"}
 
 
 class ResultsHandler(SimpleHTTPRequestHandler):

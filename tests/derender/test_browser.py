@@ -124,6 +124,27 @@ def texture_colour(folder: Path) -> np.ndarray:
     return np.median(chromaticity(albedo[:, w // 3 : 2 * w // 3]).reshape(-1, 3), axis=0)
 
 
+def assert_draws_object(shot: np.ndarray, folder: Path) -> None:
+    """The viewer's middle shows the object's colour (tone mapping desaturates it a little), not the grey
+    backdrop, and its rim shows the backdrop (the object sits inside the view)."""
+    h, w, _ = shot.shape
+    centre = shot[int(0.35 * h) : int(0.65 * h), int(0.4 * w) : int(0.6 * w)]
+    rim = np.concatenate([shot[: h // 20].reshape(-1, 3), shot[-h // 20 :].reshape(-1, 3),
+                          shot[:, : w // 20].reshape(-1, 3), shot[:, -w // 20 :].reshape(-1, 3)])
+    seen = np.median(chromaticity(centre).reshape(-1, 3), axis=0)
+    expected = texture_colour(folder)
+    assert np.abs(seen - expected).max() < 0.08, (seen, expected)
+    assert np.abs(seen - chromaticity(VIEWER_BACKDROP)).max() > 0.1, seen
+    assert (np.abs(centre.astype(int) - VIEWER_BACKDROP).max(axis=-1) < 12).mean() < 0.05
+    assert (np.abs(rim.astype(int) - VIEWER_BACKDROP).max(axis=-1) < 12).mean() > 0.9
+
+
+def wait_for_model(page) -> None:
+    page.wait_for_function("document.querySelector('model-viewer') && document.querySelector('model-viewer').loaded",
+                           timeout=60000)
+    page.wait_for_timeout(1500)  # the first frames after loading fade the model in
+
+
 def test_overview_and_3d_view_served(browser, served: str, results: Path) -> None:
     page = browser.new_page(viewport={"width": 1280, "height": 800})
     watch = PageWatch(page)
@@ -151,23 +172,11 @@ def test_overview_and_3d_view_served(browser, served: str, results: Path) -> Non
     page.fill("#search", "")
 
     page.click(f".card[data-id='{OBJECT}']")
-    page.wait_for_function("document.querySelector('model-viewer') && document.querySelector('model-viewer').loaded",
-                           timeout=60000)
-    page.wait_for_timeout(1500)  # the first frames after loading fade the model in
+    wait_for_model(page)
     keep(page.screenshot(), "gallery-object.png")
     viewer = page.locator("model-viewer")
     shot = keep(viewer.screenshot(), "gallery-3d.png")
-    h, w, _ = shot.shape
-    centre = shot[int(0.35 * h) : int(0.65 * h), int(0.4 * w) : int(0.6 * w)]
-    rim = np.concatenate([shot[: h // 20].reshape(-1, 3), shot[-h // 20 :].reshape(-1, 3),
-                          shot[:, : w // 20].reshape(-1, 3), shot[:, -w // 20 :].reshape(-1, 3)])
-    # the middle shows the object's colour (tone mapping desaturates it a little), not the grey backdrop
-    seen = np.median(chromaticity(centre).reshape(-1, 3), axis=0)
-    expected = texture_colour(results / OBJECT)
-    assert np.abs(seen - expected).max() < 0.08, (seen, expected)
-    assert np.abs(seen - chromaticity(VIEWER_BACKDROP)).max() > 0.1, seen
-    assert (np.abs(centre.astype(int) - VIEWER_BACKDROP).max(axis=-1) < 12).mean() < 0.05
-    assert (np.abs(rim.astype(int) - VIEWER_BACKDROP).max(axis=-1) < 12).mean() > 0.9  # the object sits inside
+    assert_draws_object(shot, results / OBJECT)
 
     page.click("text=sunset")
     page.wait_for_timeout(1500)
@@ -178,14 +187,27 @@ def test_overview_and_3d_view_served(browser, served: str, results: Path) -> Non
 
 
 def test_opened_from_disk(browser, results: Path) -> None:
+    """From file:// the page cannot fetch mesh.glb: it asks for the files, then draws and relights them."""
     page = browser.new_page(viewport={"width": 1280, "height": 800})
     watch = PageWatch(page)
     page.goto((results / "index.html").as_uri())
     wait_for_thumbnails(page)
     page.click(f".card[data-id='{OBJECT}']")
     page.wait_for_selector(".pictures img")
-    assert "radar serve" in page.inner_text(".viewer")  # says how to get the 3D view
+    assert "radar serve" in page.inner_text(".viewer")  # says how else to get the 3D view
     assert page.locator("model-viewer").count() == 0
+    page.set_input_files(".viewer input[type=file]",
+                         [results / OBJECT / "mesh.glb", results / OBJECT / "env_viewer.hdr"])
+    wait_for_model(page)
+    viewer = page.locator("model-viewer")
+    shot = keep(viewer.screenshot(), "gallery-3d-from-disk.png")
+    assert_draws_object(shot, results / OBJECT)
+    assert page.eval_on_selector_all(".envs button", "bs => bs.map(b => b.textContent)") == [
+        "recovered", "overcast", "studio", "sunset", "two_lights"]
+    page.click("text=studio")
+    page.wait_for_timeout(1500)
+    studio = keep(viewer.screenshot(), "gallery-3d-from-disk-studio.png")
+    assert np.abs(studio.astype(int) - shot.astype(int)).mean() > 2.0
     assert not watch.problems, watch.problems
     page.close()
 

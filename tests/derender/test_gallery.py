@@ -4,6 +4,7 @@ the vendored viewer are copied in so the folder works alone."""
 
 from __future__ import annotations
 
+import base64
 import json
 import math
 import sqlite3
@@ -85,9 +86,14 @@ def test_page_files_are_copied_and_index_points_at_them(results: Path) -> None:
     index = (results / "index.html").read_text("utf-8")
     assert ".gallery/data.js" in index and ".gallery/gallery.js" in index and "4 object(s)" in index
     assert "http://" not in index and "https://" not in index  # nothing from the network
+    env_script = (results / GALLERY_DIR / "env.js").read_text("ascii")
+    assert env_script.startswith("window.RADAR_ENVS = ")
+    embedded = json.loads(env_script.removeprefix("window.RADAR_ENVS = ").rstrip().rstrip(";"))
     for name in ("overcast", "studio", "sunset", "two_lights"):
-        hdr = cv2.imread(str(results / GALLERY_DIR / "env" / f"{name}.hdr"), cv2.IMREAD_UNCHANGED)
+        hdr_file = results / GALLERY_DIR / "env" / f"{name}.hdr"
+        hdr = cv2.imread(str(hdr_file), cv2.IMREAD_UNCHANGED)
         assert hdr.shape == (64, 128, 3) and hdr.min() >= 0 and hdr.max() > 0
+        assert base64.b64decode(embedded[name]) == hdr_file.read_bytes()  # the same file for a page from disk
 
 
 def test_thumbnails_are_small_and_written_once(results: Path) -> None:
