@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from radar_cli.derender.environments import builtin_environments
+from radar_cli.errors import RadarError
 from radar_cli.fileio import atomic_path, read_image, write_image, write_text
 from radar_cli.results import (ENV_MAP_FILE, INDEX_FILE, INPUT_FILE, MATERIAL_FILE, RECON_FILE, RELIT_PREFIX,
                                SUMMARY_FILE)
@@ -194,7 +195,10 @@ def write_gallery(root: Path, records: list[tuple[str, dict]], n_failed: int) ->
     entries, catalogs = [], {}
     try:
         for name, rec in records:
-            write_object_files(root / name)
+            try:
+                write_object_files(root / name)
+            except (RadarError, OSError, ValueError):
+                pass  # an unreadable picture costs its thumbnail or viewer lighting, not the gallery
             entries.append(object_entry(root / name, rec, catalogs))
     finally:
         for db in catalogs.values():

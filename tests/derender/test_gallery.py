@@ -7,6 +7,7 @@ from __future__ import annotations
 import base64
 import json
 import math
+import shutil
 import sqlite3
 from pathlib import Path
 
@@ -103,6 +104,16 @@ def test_thumbnails_are_small_and_written_once(results: Path) -> None:
     before = thumb.stat().st_mtime_ns
     write_gallery(results, read_records(results), 0)
     assert thumb.stat().st_mtime_ns == before  # up to date: not rewritten for every report
+
+
+def test_an_unreadable_picture_costs_only_its_thumbnail(results: Path, tmp_path: Path) -> None:
+    root = tmp_path / "copy"
+    shutil.copytree(results, root)
+    (root / "d_plain" / THUMBNAIL_FILE).unlink()
+    (root / "d_plain" / "input.png").write_bytes(b"not a png")
+    write_report(root, [])
+    objects = {o["id"]: o for o in gallery_data(root)["objects"]}
+    assert not objects["d_plain"]["thumbnail"] and objects["a_ok"]["thumbnail"] and len(objects) == 4
 
 
 def test_viewer_environment_puts_the_camera_side_at_three_js_plus_z() -> None:
