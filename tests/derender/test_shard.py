@@ -164,3 +164,9 @@ def test_a_killed_rank_is_finished_by_rerunning(photos: Path, single_run: Path, 
     assert done.returncode == 0, done.stderr[-3000:]
     assert summary_objects(out) == [f"vase_{k:02d}" for k in range(N_INPUTS)]
     assert object_files(out) == object_files(single_run)
+
+
+def test_torchrun_refuses_a_shard_option(photos: Path, tmp_path: Path) -> None:
+    cmd = _derender_cmd(photos, tmp_path / "out", 2) + ["--shard", "0/2"]
+    done = subprocess.run(cmd, env=_env(), capture_output=True, text=True, timeout=300)
+    assert done.returncode != 0 and "--shard cannot be combined with torchrun" in done.stderr
