@@ -20,7 +20,7 @@ ALBEDO ?= network
 # PITCH=search scores `radar derender --pitch search` (the test-time pitch search) instead of f_S's pitch
 PITCH ?= network
 
-.PHONY: install demo test test-all test-gpu clean \
+.PHONY: install demo test test-all test-gpu test-browser clean \
         syn-data syn-data-cpu train-syn train-syn-cpu eval-syn eval-syn-cpu table2 table2-cpu \
         met-fetch met-masks train-met real-vases bench
 
@@ -47,6 +47,14 @@ test-all: $(STAMP)
 # CPU-vs-CUDA agreement of the renderer, the losses and the bundled model (each test skips without CUDA)
 test-gpu: $(STAMP)
 	$(BIN)/python -m pytest -q -m gpu tests
+
+# The gallery in a real browser: Debian's Chromium (headless, software WebGL) driven by Playwright, which is told to
+# use that Chromium and never downloads one. Installing Chromium needs root (or sudo).
+test-browser: $(STAMP)
+	command -v chromium >/dev/null || { apt-get update && apt-get install -y chromium; } || \
+		{ sudo apt-get update && sudo apt-get install -y chromium; }
+	$(BIN)/pip install -q -e '.[test,browser]'
+	$(BIN)/python -m pytest -q -s -m browser tests
 
 clean:
 	rm -rf $(VENV) demo_out .pytest_cache

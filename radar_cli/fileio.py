@@ -35,6 +35,17 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         raise
 
 
+def remove_stale_temps(folder: str | Path) -> int:
+    """Delete the temporary files atomic_path left in `folder` when its process was killed mid-write (the
+    finished files are never touched); the number removed."""
+    removed = 0
+    for tmp in Path(folder).glob(".*.tmp*"):
+        if tmp.is_file():
+            tmp.unlink(missing_ok=True)
+            removed += 1
+    return removed
+
+
 def write_bytes(path: str | Path, data: bytes) -> None:
     """Write bytes atomically."""
     with atomic_path(path) as tmp:

@@ -20,6 +20,7 @@ COMMANDS: list[tuple[str, str, str, str]] = [
     ("synth", "radar_cli.cli.synth", "synth", "Render synthetic vases with full ground truth."),
     ("train", "radar_cli.cli.train", "train", "Train the RADAR model on a prepared or synthetic dataset."),
     ("derender", "radar_cli.cli.derender", "derender", "De-render photographs into per-object folders of exports."),
+    ("serve", "radar_cli.cli.serve", "serve", "Show a results folder's gallery and 3D viewer at a local address."),
     ("relight", "radar_cli.cli.relight", "relight", "Re-render a de-rendered object under new light and view."),
     ("eval", "radar_cli.cli.eval", "eval_cmd", "Score de-rendering results against synthetic ground truth."),
     ("bench", "radar_cli.cli.bench", "bench", "Time a stage of the pipeline and print JSON."),

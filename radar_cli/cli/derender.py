@@ -7,12 +7,13 @@ from pathlib import Path
 
 import click
 
-from radar_cli.derender.batch import DerenderOptions, derender as run_derender
+from radar_cli.derender.batch import DerenderOptions
 from radar_cli.derender.contact_sheet import contact_sheet as write_contact_sheet
 from radar_cli.derender.export import MIN_VIEW_SIZE, ExportConfig
 from radar_cli.derender.inputs import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION, Resolution
 from radar_cli.derender.predictor import ALBEDO_SOURCES, PITCH_SOURCES, Predictor
 from radar_cli.derender.refine import REFINE_MODES
+from radar_cli.derender.shard import Shard, derender_sharded
 
 
 class ResolutionType(click.ParamType):
@@ -75,22 +76,32 @@ RESOLUTION = ResolutionType()
 @click.option("--threads", type=click.IntRange(1, 256), default=1, show_default=True,
               help="torch threads for the network (more helps only on an otherwise idle machine).")
 @click.option("--overwrite", is_flag=True, help="Redo objects whose folders are already complete.")
+@click.option("--shard", "shard", default="0/1", show_default=True, metavar="K/N",
+              help="De-render only share K (0..N-1) of N, for batch schedulers; under torchrun each rank takes "
+                   "its share by itself. Every share writes into the same --out.")
 @click.option("--contact-sheet", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Also write a contact sheet PNG (input, reconstruction, albedo, relit view per object).")
 def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks: Path | None, crop: str,
              backdrop: str, device: str, albedo: str, pitch: str, refine: str, resolution: Resolution, views: int,
-             view_size: int | None, envs: tuple[Path, ...],
-             batch_size: int, workers: int, threads: int, overwrite: bool, contact_sheet: Path | None) -> None:
-    """De-render INPUTS (image files, folders, prepared dataset folders) into --out."""
-    predictor = Predictor.from_checkpoint(checkpoint, device, albedo, pitch, refine)  # type: ignore[arg-type]
+             view_size: int | None, envs: tuple[Path, ...], batch_size: int, workers: int, threads: int,
+             overwrite: bool, shard: str, contact_sheet: Path | None) -> None:
+    """De-render INPUTS (image files, folders, prepared dataset folders) into --out.
+
+    On many processes or machines: `torchrun --nnodes N --nproc_per_node P -m radar_cli derender ...` (rank 0
+    writes the report for all), or one `--shard K/N` job per share. Rerunning the same command finishes the
+    objects a killed process left."""
+    def load(dev: str) -> Predictor:
+        return Predictor.from_checkpoint(checkpoint, dev, albedo, pitch, refine)  # type: ignore[arg-type]
+
     options = DerenderOptions(out=out, crop=crop, backdrop=backdrop, masks=masks,  # type: ignore[arg-type]
                               envs=envs, batch_size=batch_size, workers=workers, threads=threads, overwrite=overwrite,
-                              export=ExportConfig(views, view_size), resolution=resolution)
-    summary = run_derender(list(inputs), predictor, options, say=lambda line: click.echo(line, err=True))
-    if contact_sheet is not None and (summary.done or summary.skipped):
+                              export=ExportConfig(views, view_size), resolution=resolution, shard=Shard.parse(shard))
+    summary = derender_sharded(list(inputs), load, options, device, say=lambda line: click.echo(line, err=True))
+    if contact_sheet is not None and summary.index is not None and (summary.done or summary.skipped):
         click.echo(f"contact sheet: {write_contact_sheet(out, contact_sheet)}")
     click.echo(summary.line())
-    click.echo(f"gallery: {summary.index}")
+    if summary.index is not None:
+        click.echo(f"gallery: {summary.index}")
     if summary.failures:
         click.echo(f"{len(summary.failures)} input(s) failed: see {out / 'failures.csv'}", err=True)
         sys.exit(1)

@@ -1,7 +1,9 @@
 """The `radar derender` driver: inputs -> crops -> network in batches -> per-object exports -> report.
 
 One bad input costs one line and one failures.csv row; the rest are processed. Finished object folders are
-skipped (a killed run resumes) and never overwritten without `overwrite`.
+skipped (a killed run resumes) and never overwritten without `overwrite`. Batches are cut from the whole input
+list before finished objects are dropped, so an object is always predicted beside the same neighbours (its files
+are the same bytes whether the run was resumed or split into shares, see radar_cli.derender.shard).
 """
 
 from __future__ import annotations
@@ -23,8 +25,10 @@ from radar_cli.derender.inputs import (DEFAULT_RESOLUTION, Backdrop, CropMode, F
                                        Resolution, collect_inputs, output_side, prepare)
 from radar_cli.derender.predictor import Predictor
 from radar_cli.derender.report import write_report
+from radar_cli.derender.shard import Shard, read_share_failures, write_share_failures
 from radar_cli.derender.upsample import full_resolution_state
 from radar_cli.errors import InputError, RadarError
+from radar_cli.fileio import remove_stale_temps
 from radar_cli.model.outputs import Decomposition
 
 T, R = TypeVar("T"), TypeVar("R")
@@ -50,6 +54,8 @@ class DerenderOptions:
     export: ExportConfig = field(default_factory=ExportConfig)
     resolution: Resolution = DEFAULT_RESOLUTION
     """Side of the outputs (inputs.output_side): an integer, or `photo` for each crop's own size."""
+    shard: Shard = Shard()
+    """The share of the inputs this process de-renders (0/1: all of them)."""
 
 
 @dataclass
@@ -109,28 +115,31 @@ def _prepare_all(items: list[InputItem], size: int, options: DerenderOptions) ->
     return _thread_map(one, items, options.workers)
 
 
-def _pending(items: list[InputItem], out: Path, overwrite: bool, summary: BatchSummary,
-             say: Callable[[str], None]) -> list[InputItem]:
-    """The items still to do; finished folders are skipped unless `overwrite`."""
-    todo = []
-    for item in items:
+def _pending(batch: list[InputItem], out: Path, overwrite: bool, summary: BatchSummary,
+             say: Callable[[str], None]) -> set[str]:
+    """The names of a batch still to do; finished folders are skipped unless `overwrite`."""
+    todo = set()
+    for item in batch:
         if is_complete(out / item.name) and not overwrite:
             summary.skipped.append(item.name)
             say(f"{item.name}: skipped, {out / item.name} exists (use --overwrite to redo it)")
         else:
-            todo.append(item)
+            todo.add(item.name)
+            remove_stale_temps(out / item.name)  # what a killed run was writing
     return todo
 
 
 def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOptions,
-             say: Callable[[str], None] = tqdm.write) -> BatchSummary:
-    """De-render every input into options.out/<name>/ and write index.html, summary.csv and failures.csv.
+             say: Callable[[str], None] = tqdm.write, report: bool = True) -> BatchSummary:
+    """De-render every input (of options.shard's share) into options.out/<name>/ and write index.html,
+    summary.csv and failures.csv.
 
     Args:
         inputs: image files, folders, prepared dataset folders.
         predictor: the model.
         options: output folder and settings.
         say: where one-line messages (skips, failures) go.
+        report: write the report (False: a torchrun rank, whose rank 0 writes it for all).
 
     Returns:
         BatchSummary; the caller decides the exit code (non-zero if any failure).
@@ -142,27 +151,37 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
     render = predictor.setup.render
     envs = environments(options.envs, render.env_height, render.env_width)
     items, failures = collect_inputs(list(inputs), options.masks, exclude=options.out)
-    summary = BatchSummary(failures=list(failures))
-    for f in failures:
+    shard = options.shard
+    summary = BatchSummary(failures=list(failures) if shard.index == 0 else [])  # input errors: share 0 records
+    for f in summary.failures:
         say(f.line())
     options.out.mkdir(parents=True, exist_ok=True)
-    todo = _pending(items, options.out, options.overwrite, summary, say)
-    with torch_threads(options.threads), tqdm(total=len(todo), desc="derender", unit="obj", disable=None) as bar:
-        for i in range(0, len(todo), options.batch_size):
-            chunk = todo[i : i + options.batch_size]
-            _run_batch(chunk, predictor, options, envs, summary, say)
-            bar.update(len(chunk))
-    summary.index = write_report(options.out, summary.failures)
+    batches = shard.blocks(items, options.batch_size)
+    with torch_threads(options.threads), tqdm(total=sum(map(len, batches)), desc="derender", unit="obj",
+                                              disable=None) as bar:
+        for batch in batches:
+            todo = _pending(batch, options.out, options.overwrite, summary, say)
+            if todo:
+                _run_batch(batch, todo, predictor, options, envs, summary, say)
+            bar.update(len(batch))
+    if shard.enabled:
+        write_share_failures(options.out, shard, summary.failures)
+    if report:
+        merged = read_share_failures(options.out, shard.count) if shard.enabled else summary.failures
+        summary.index = write_report(options.out, merged)
     summary.seconds = time.perf_counter() - start
     return summary
 
 
-def _run_batch(chunk: list[InputItem], predictor: Predictor, options: DerenderOptions,
+def _run_batch(chunk: list[InputItem], todo: set[str], predictor: Predictor, options: DerenderOptions,
                envs: dict[str, np.ndarray], summary: BatchSummary, say: Callable[[str], None]) -> None:
-    """Crop, predict and export one batch; failures are recorded item by item."""
+    """Crop and predict one whole batch and export its objects named in `todo`; failures are recorded item by
+    item (a finished object is predicted again only so that its neighbours see the same batch)."""
     prepared = _prepare_all(chunk, predictor.setup.image_size, options)
     ok = []
     for item, prep in zip(chunk, prepared):
+        if item.name not in todo and isinstance(prep, Failure):
+            continue
         if isinstance(prep, Failure):
             summary.failures.append(prep)
             say(prep.line())
@@ -172,14 +191,15 @@ def _run_batch(chunk: list[InputItem], predictor: Predictor, options: DerenderOp
         return
     dec = predictor.predict([prep.image for _, prep in ok], [prep.silhouette for _, prep in ok])
     with torch_threads(EXPORT_THREADS):
-        _export_all(ok, dec, predictor, options, envs, summary, say)
+        _export_all(ok, todo, dec, predictor, options, envs, summary, say)
 
 
-def _export_all(ok: list[tuple[InputItem, Prepared]], dec: Decomposition, predictor: Predictor,
+def _export_all(ok: list[tuple[InputItem, Prepared]], todo: set[str], dec: Decomposition, predictor: Predictor,
                 options: DerenderOptions, envs: dict[str, np.ndarray], summary: BatchSummary,
                 say: Callable[[str], None]) -> None:
-    """Export each predicted object, options.workers at a time (threads: PNG and zlib encoding and torch's
-    operations release the GIL, and each object writes its own folder); an error costs that object only."""
+    """Export each predicted object named in `todo`, options.workers at a time (threads: PNG and zlib encoding
+    and torch's operations release the GIL, and each object writes its own folder); an error costs that object
+    only."""
     def one(k: int) -> Failure | None:
         item, prep = ok[k]
         try:
@@ -194,8 +214,10 @@ def _export_all(ok: list[tuple[InputItem, Prepared]], dec: Decomposition, predic
             return Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
         return None
 
+    ks = [k for k, (item, _) in enumerate(ok) if item.name in todo]
     # recorded in input order, whatever finished first
-    for (item, _), failure in zip(ok, _thread_map(one, range(len(ok)), options.workers)):
+    for k, failure in zip(ks, _thread_map(one, ks, options.workers)):
+        item = ok[k][0]
         if failure is None:
             summary.done.append(item.name)
         else:

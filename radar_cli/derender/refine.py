@@ -48,13 +48,13 @@ class RefineReport:
     seconds: float = 0.0
 
     def record(self) -> dict:
-        """material.json's `refine` entry (NaN written as null)."""
+        """material.json's `refine` entry (NaN written as null; no time, so the same input writes the same
+        bytes)."""
         clean = lambda v: None if v != v else round(v, 4)  # noqa: E731
         return {"status": self.status, "reason": self.reason, "resolution": self.resolution,
                 "pitch_cue": self.pitch_cue, "outline_px": {"refined": clean(self.outline_px[0]),
                                                             "network": clean(self.outline_px[1])},
-                "silhouette_iou": {"refined": clean(self.iou[0]), "network": clean(self.iou[1])},
-                "seconds": round(self.seconds, 3)}
+                "silhouette_iou": {"refined": clean(self.iou[0]), "network": clean(self.iou[1])}}
 
 
 def silhouette_iou(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, mask: np.ndarray,

@@ -21,6 +21,7 @@ from radar_cli.derender.predictor import Predictor
 from radar_cli.results import MATERIAL_KEYS, ResultPaths, list_results
 
 from .conftest import SETUP, SIZE, write_photo
+from .test_gallery import gallery_data
 
 EXPORT = ExportConfig(views=4, view_size=32)
 PNGS = ("input.png", "mask.png", "mask_front.png", "albedo.png", "texture.png", "normal.png", "diffuse.png",
@@ -96,9 +97,12 @@ def test_crop_box_recorded(results: Path) -> None:
 def test_gallery_and_summary(results: Path) -> None:
     page = (results / "index.html").read_text()
     assert "http" not in page  # no network needed
-    for src in ("square/recon.png", "wide/turntable.gif", "wide/relit_sunset.png", "wide/relit_gallery.png",
-                "square/mesh.glb"):
-        assert f'"{src}"' in page and (results / src).is_file()
+    objects = {o["id"]: o for o in gallery_data(results)["objects"]}
+    assert sorted(objects) == ["square", "wide"]
+    assert objects["wide"]["relit"] == ["gallery", "overcast", "studio", "sunset", "two_lights"]  # --env's too
+    for src in ("square/recon.png", "wide/turntable.gif", "wide/relit_gallery.png", "square/mesh.glb",
+                "square/thumbnail.png", "wide/env_viewer.hdr"):
+        assert (results / src).is_file()
     rows = list(csv.DictReader((results / "summary.csv").open()))
     assert [r["object"] for r in rows] == ["square", "wide"] and float(rows[0]["alpha"]) > 0
     assert (results / "failures.csv").read_text().strip() == "source,problem"
@@ -107,7 +111,7 @@ def test_gallery_and_summary(results: Path) -> None:
 @pytest.fixture
 def fake_checkpoint(monkeypatch, predictor: Predictor) -> None:
     monkeypatch.setattr(Predictor, "from_checkpoint",
-                        classmethod(lambda cls, path, device, albedo, pitch: predictor))
+                        classmethod(lambda cls, path, device, albedo, pitch, refine="none": predictor))
 
 
 def test_cli_bad_inputs_one_line_each(tmp_path: Path, fake_checkpoint) -> None:

@@ -1,0 +1,124 @@
+"""Splitting one `radar derender` collection over processes and machines: which inputs a share owns, the
+per-share failure lists, and the torchrun driver in which rank 0 writes the one report for all.
+
+A share owns whole batches of the single-process run (batch k goes to share k mod N), so every object is
+predicted beside the same neighbours as without sharding and its files are the same bytes. Shares meet only
+through the results folder (a filesystem all machines see), so `--shard K/N` needs no network between jobs.
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import io
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Callable, Sequence, TypeVar
+
+from radar_cli.derender.inputs import Failure
+from radar_cli.errors import InputError
+from radar_cli.fileio import write_text
+
+if TYPE_CHECKING:
+    from radar_cli.derender.batch import BatchSummary, DerenderOptions
+    from radar_cli.derender.predictor import Predictor
+
+T = TypeVar("T")
+SHARDS_DIR = ".shards"  # RESULTS/.shards/failures-K-of-N.csv: each share's failures, merged into failures.csv
+MAX_FAILURE_BYTES = 64 * 1024 * 1024  # a share's failure list is read back; refuse absurd files
+
+
+@dataclass(frozen=True)
+class Shard:
+    """Share `index` (0-based) of `count`."""
+
+    index: int = 0
+    count: int = 1
+
+    def __post_init__(self) -> None:
+        if self.count < 1 or not 0 <= self.index < self.count:
+            raise InputError(f"--shard {self.index}/{self.count}: K must lie in 0..N-1 and N >= 1")
+
+    @classmethod
+    def parse(cls, text: str) -> "Shard":
+        """'K/N' (0-based K, e.g. a SLURM array's task id) -> Shard; InputError on anything else."""
+        match = re.fullmatch(r"\s*(\d+)\s*/\s*(\d+)\s*", text)
+        if match is None:
+            raise InputError(f"--shard {text!r}: expected K/N, e.g. 0/4 (K = 0..N-1)")
+        return cls(int(match.group(1)), int(match.group(2)))
+
+    @property
+    def enabled(self) -> bool:
+        return self.count > 1
+
+    def blocks(self, items: Sequence[T], size: int) -> list[list[T]]:
+        """This share's batches: the run's items cut into batches of `size` in order, every N-th from K."""
+        batches = [list(items[i : i + size]) for i in range(0, len(items), size)]
+        return batches[self.index :: self.count]
+
+    def failures_path(self, out: Path) -> Path:
+        return out / SHARDS_DIR / f"failures-{self.index}-of-{self.count}.csv"
+
+
+def write_share_failures(out: Path, shard: Shard, failures: list[Failure]) -> None:
+    """Record one share's failures where the report's writer finds them."""
+    buf = io.StringIO()
+    writer = csv.writer(buf)
+    writer.writerow(("source", "problem"))
+    writer.writerows((f.source, f.problem) for f in failures)
+    write_text(shard.failures_path(out), buf.getvalue())
+
+
+def read_share_failures(out: Path, count: int) -> list[Failure]:
+    """The failures of every share of an N-way run found under `out` (duplicates once, in share order)."""
+    merged: dict[tuple[str, str], Failure] = {}
+    for k in range(count):
+        path = Shard(k, count).failures_path(out)
+        if not path.is_file():
+            continue
+        if path.stat().st_size > MAX_FAILURE_BYTES:
+            raise InputError(f"{path}: larger than {MAX_FAILURE_BYTES // 2**20} MB")
+        rows = list(csv.reader(io.StringIO(path.read_text("utf-8"))))
+        for row in rows[1:]:
+            if len(row) == 2:
+                merged.setdefault((row[0], row[1]), Failure(row[0], row[1]))
+    return list(merged.values())
+
+
+def derender_sharded(inputs: list[str | Path], load: Callable[[str], "Predictor"], options: "DerenderOptions",
+                     device: str, say: Callable[[str], None]) -> "BatchSummary":
+    """Run `radar derender` as one share of a collection.
+
+    Under torchrun (WORLD_SIZE > 1) the rank is the share; ranks wait for each other at the end and rank 0 writes
+    summary.csv, failures.csv and the gallery for all. Otherwise options.shard says the share (1/1: the whole
+    collection) and the share writes the report from every complete folder and every share's failures found.
+
+    Args:
+        inputs: image files and folders, the same on every share.
+        load: device name -> Predictor (each rank loads the model on its own device).
+        options: the run's options; options.shard must be 0/1 under torchrun.
+        device: --device (under torchrun with CUDA each rank takes its LOCAL_RANK's GPU).
+        say: where one-line messages go.
+
+    Returns:
+        This share's BatchSummary (its `index` set on the share that wrote the report).
+    """
+    from radar_cli.derender.batch import derender
+    from radar_cli.derender.report import write_report
+    from radar_cli.train import distributed
+
+    info = distributed.setup(device)
+    try:
+        if info.enabled and options.shard.enabled:
+            raise InputError("--shard cannot be combined with torchrun (each rank takes its share already)")
+        shard = Shard(info.rank, info.world) if info.enabled else options.shard
+        options = dataclasses.replace(options, shard=shard)
+        summary = derender(inputs, load(str(info.device)), options, say, report=not info.enabled)
+        distributed.barrier(info)  # every share's folders and failure list are written
+        if info.enabled and info.is_main:
+            summary.index = write_report(options.out, read_share_failures(options.out, shard.count))
+        distributed.barrier(info)  # no rank exits (and has torchrun stop the others) before the report is done
+        return summary
+    finally:
+        distributed.teardown(info)
