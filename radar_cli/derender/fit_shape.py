@@ -37,6 +37,8 @@ class ShapeFitConfig:
         roughness_weight: the profile's bending (sum of squared second differences x 1e3, at 64 rows).
         basin: the lip may pick any candidate whose outline score is within this of the best.
         lip_contrast: the lip is trusted where its contrast (grey levels 0..1) exceeds this.
+        lip_tie: coarse candidates whose lip is at least this fraction of the strongest count as tied; the
+            outline picks among them.
         lip_offset_px, fine_lip_offset_px: the lip's two sides are sampled this far above and below the arc (px
             at 512 px), on the coarse grid (wide: finds the lip) and on the fine one (narrow: places it).
         width_rounds: rounds of correct_widths at full resolution after the search.
@@ -53,6 +55,7 @@ class ShapeFitConfig:
     roughness_weight: float = 0.5
     basin: float = 3.0
     lip_contrast: float = 0.1
+    lip_tie: float = 0.9
     lip_offset_px: float = 2.0
     fine_lip_offset_px: float = 1.0
     width_rounds: int = 3
@@ -177,13 +180,15 @@ def closed_form(target: Outline, size: int, pitches: torch.Tensor, roll: float, 
 def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
                  offset_px: float, camera: CameraConfig, samples: int = 512) -> torch.Tensor:
     """B contrasts of the rim's front arc: the mean grey level just below it (outer wall) minus just above it
-    (the inside, seen through the mouth), over the middle 80% of the arc.
+    (the inside, seen through the mouth), over the middle 80% of the arc, where both sides lie on the object.
 
     Args:
-        grey: 1 x 1 x S x S grey image in [0, 1]. radius: B x L; height: B; pose: B x 4.
+        grey: 1 x 2 x S x S: the grey image in [0, 1] and the object's coverage. radius: B x L; height: B;
+            pose: B x 4.
 
     Returns:
-        B contrasts (0 where the rim's ellipse has no width, i.e. seen edge on).
+        B contrasts (0 where the rim's ellipse has no width, i.e. seen edge on, or where less than half of the
+        arc's samples lie on the object).
     """
     q = disc_conics(radius, height, pose, 2, camera)[:, 0]  # B x 3 x 3, the top disc
     x = torch.linspace(-1, 1, samples, dtype=torch.float64)
@@ -198,9 +203,11 @@ def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor,
     y = torch.nan_to_num(front)
     points = torch.stack([torch.stack([x.expand_as(y), -(y + step)], -1),  # above the arc (inside); rows down
                           torch.stack([x.expand_as(y), -(y - step)], -1)], 1)  # below the arc (outer wall)
-    values = F.grid_sample(grey.expand(len(y), -1, -1, -1), points.float(), align_corners=False)[:, 0]  # B x 2 x N
-    diff = (values[:, 1] - values[:, 0]).double() * use
-    return diff.sum(1) / use.sum(1).clamp_min(1)
+    values = F.grid_sample(grey.expand(len(y), -1, -1, -1), points.float(), align_corners=False)  # B x 2 x 2 x N
+    on_object = use & (values[:, 1].amin(dim=1) > 0.99)  # both sides well inside the silhouette
+    diff = (values[:, 0, 1] - values[:, 0, 0]).double() * on_object
+    enough = on_object.sum(1) >= 0.5 * use.sum(1).clamp_min(1)
+    return torch.where(enough, diff.sum(1) / on_object.sum(1).clamp_min(1), torch.zeros_like(diff[:, 0]))
 
 
 def _search(target: Outline, grey: torch.Tensor, size: int, pitches: torch.Tensor, roll: float, tx: float,
@@ -213,18 +220,21 @@ def _search(target: Outline, grey: torch.Tensor, size: int, pitches: torch.Tenso
 
 
 def _pick(score: torch.Tensor, contrast: torch.Tensor, config: ShapeFitConfig) -> tuple[int, str]:
-    """The candidate with the strongest lip inside the outline's basin if that lip is strong enough, else the
-    best outline score."""
+    """The candidate with the strongest lip inside the outline's basin if that lip is strong enough (the best
+    outline among near-ties), else the best outline score."""
     lips = torch.where(score <= score.min() + config.basin, contrast, torch.full_like(contrast, -math.inf))
     if float(lips.max()) > config.lip_contrast:
-        return int(lips.argmax()), "lip"
+        # several arcs as strong as the best (an edge inside the mouth that many arcs cross): the outline decides
+        strong = lips >= config.lip_tie * lips.max()
+        return int(torch.where(strong, score, torch.full_like(score, math.inf)).argmin()), "lip"
     return int(score.argmin()), "outline"
 
 
 def search_pitch(target: Outline, grey: torch.Tensor, size: int, config: ShapeFitConfig,
                  camera: CameraConfig) -> tuple[tuple[torch.Tensor, ...], str]:
-    """Coarse then fine pitch grids; the fine one keeps the coarse one's cue. Returns ((radius, height, pose)
-    of the chosen candidate, batch of one, float64; the cue)."""
+    """Coarse then fine pitch grids; the fine one keeps the coarse one's cue. `grey`: 1 x 2 x N x N image and
+    coverage (lip_contrast). Returns ((radius, height, pose) of the chosen candidate, batch of one, float64; the
+    cue)."""
     roll, tx = axis_from_outline(target, size, camera)
     coarse = torch.arange(0.0, config.pitch_max + 1e-6, config.coarse_step, dtype=torch.float64)
     _, score, contrast = _search(target, grey, size, coarse, roll, tx, config, camera, config.lip_offset_px)
@@ -276,7 +286,7 @@ def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = Shape
     size = mask.shape[0]
     grid = min(size, config.grid_size)
     coarse_target = mask_outline(downsample(mask, grid))
-    grey_t = torch.from_numpy(np.asarray(grey, np.float32))[None, None]
+    grey_t = torch.from_numpy(np.stack([np.asarray(grey, np.float32), np.asarray(mask, np.float32)]))[None]
     (radius, height, pose), cue = search_pitch(coarse_target, grey_t, grid, config, camera)
     target = mask_outline(np.asarray(mask, np.float64))
     radius = correct_widths(target, size, radius, height, pose, config.width_rounds, camera)
