@@ -3,6 +3,7 @@
 
     RESULTS/<object id>/input.png             the network's input crop (RGB)
     RESULTS/<object id>/mask.png              predicted silhouette (L, 255 = object)
+    RESULTS/<object id>/silhouette.png        located or given silhouette, when known (L, 255 = object)
     RESULTS/<object id>/mask_front.png        rendered frontal-third silhouette (the region L_im is scored on)
     RESULTS/<object id>/albedo_rendered.png   diffuse albedo drawn in image space (tone-mapped, sRGB-like)
     RESULTS/<object id>/normal_rendered.png   camera-space normals in image space, (n + 1) / 2 as RGB
@@ -19,6 +20,7 @@ from pathlib import Path
 
 INPUT_FILE = "input.png"
 MASK_FILE = "mask.png"
+SILHOUETTE_FILE = "silhouette.png"  # the located or given silhouette the object was fitted to (L, 255 = object)
 MASK_FRONT_FILE = "mask_front.png"
 ALBEDO_RENDERED_FILE = "albedo_rendered.png"
 NORMAL_RENDERED_FILE = "normal_rendered.png"

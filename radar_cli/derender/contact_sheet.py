@@ -20,7 +20,7 @@ NAME_W = 150
 MAX_ROWS = 500
 
 
-def _tile(path: Path, matte: Path | None = None) -> Image.Image:
+def tile(path: Path, matte: Path | None = None) -> Image.Image:
     """An image resized to TILE x TILE (grey if missing); with a matte (L mask), put on white outside it."""
     try:
         with Image.open(path) as im:
@@ -62,6 +62,6 @@ def contact_sheet(root: str | Path, out: str | Path, env: str = "studio") -> Pat
         draw.text((4, y + TILE // 2), name[:24], fill=(0, 0, 0))
         for c, (file, _) in enumerate(columns):
             matte = root / name / MASK_FILE if file == ALBEDO_RENDERED_FILE else None  # drawn on black for eval
-            sheet.paste(_tile(root / name / file, matte), (NAME_W + c * TILE, y))
+            sheet.paste(tile(root / name / file, matte), (NAME_W + c * TILE, y))
     write_image(out, np.asarray(sheet))
     return Path(out)

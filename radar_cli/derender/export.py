@@ -15,7 +15,7 @@ from radar_cli.derender.predictor import AlbedoSource, ModelSetup, PitchSource
 from radar_cli.derender.renders import write_renders
 from radar_cli.derender.state import ObjectState
 from radar_cli.fileio import write_json
-from radar_cli.results import INPUT_FILE, MATERIAL_FILE
+from radar_cli.results import INPUT_FILE, MATERIAL_FILE, SILHOUETTE_FILE
 
 
 MIN_VIEW_SIZE = 128
@@ -66,6 +66,8 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
     (folder / MATERIAL_FILE).unlink(missing_ok=True)  # incomplete until rewritten at the end
     side = prepared.side
     write_picture(folder / INPUT_FILE, prepared.photo_image)
+    if prepared.photo_silhouette is not None:
+        write_picture(folder / SILHOUETTE_FILE, prepared.photo_silhouette.astype(np.uint8) * 255)
     write_maps(folder, state, setup.render)
     write_meshes(folder, state, setup.geometry.n_cols)
     write_renders(folder, state, side, config.view_side(side), config.views, envs)
