@@ -12,11 +12,12 @@ from radar_cli.derender.inputs import InputItem, Prepared
 from radar_cli.derender.maps import write_maps
 from radar_cli.derender.mesh import write_meshes
 from radar_cli.derender.predictor import AlbedoSource, ModelSetup, PitchSource
+from radar_cli.derender.quality import assess
 from radar_cli.derender.renders import write_renders
 from radar_cli.derender.state import ObjectState
 from radar_cli.fileio import write_image, write_json
 from radar_cli.model.outputs import Decomposition
-from radar_cli.results import INPUT_FILE, MATERIAL_FILE
+from radar_cli.results import APPENDAGES_FILE, INPUT_FILE, MATERIAL_FILE
 
 
 @dataclass(frozen=True)
@@ -57,6 +58,8 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomp
     (folder / MATERIAL_FILE).unlink(missing_ok=True)  # incomplete until rewritten at the end
     state = ObjectState.from_decomposition(dec, setup.render, setup.camera)
     write_image(folder / INPUT_FILE, prepared.image)
+    if prepared.appendages is not None:
+        write_image(folder / APPENDAGES_FILE, prepared.appendages.astype(np.uint8) * 255)
     write_maps(folder, state, setup.render)
     write_meshes(folder, state, setup.geometry.n_cols)
     write_renders(folder, state, setup.image_size, config.view_size, config.views, envs)
@@ -71,6 +74,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, dec: Decomp
         "albedo_source": albedo_source,
         "pitch_source": pitch_source,
         "environments": sorted(envs),
+        "quality": assess(prepared, state),
     })
     write_json(folder / MATERIAL_FILE, record)
     return record

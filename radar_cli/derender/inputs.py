@@ -57,7 +57,11 @@ class Prepared:
         crop: the square window of the original photo the crop shows (x0, y0, side in its pixels).
         photo_size: (width, height) of the original photo after EXIF orientation.
         backdrop: `white` if the backdrop was replaced by white, else `kept`.
-        silhouette: S x S bool object mask of the crop, when known (located, --masks or the dataset's mask.png).
+        silhouette: S x S bool object mask of the crop, when known (located, --masks or the dataset's mask.png):
+            the symmetric core of a located or --masks silhouette (handles, spouts, knobs left out).
+        appendages: S x S bool, the located object's pixels left out of the core; None if not split.
+        cut_edges: the photo edges the located object runs into (`top`, `bottom`, `left`, `right`).
+        frame_coverage: share of the photo the located object covers; None if not located.
     """
 
     image: np.ndarray
@@ -65,6 +69,9 @@ class Prepared:
     photo_size: tuple[int, int]
     backdrop: str = "kept"
     silhouette: np.ndarray | None = None
+    appendages: np.ndarray | None = None
+    cut_edges: tuple[str, ...] = ()
+    frame_coverage: float | None = None
 
 
 def _is_image(path: Path) -> bool:
@@ -162,28 +169,6 @@ def _unique(found: list[InputItem], failures: list[Failure]) -> list[InputItem]:
     return items
 
 
-def locate(photo: np.ndarray, size: int, name: str) -> tuple[np.ndarray, CropBox, np.ndarray]:
-    """The object's square crop, cut exactly as `radar masks` cuts its training crops (detect, GrabCut, frame).
-
-    Args:
-        photo: H x W x 3 uint8.
-        size: S, the crop side.
-        name: the file, for messages.
-
-    Returns:
-        (S x S x 3 uint8 crop, its window in the photo, S x S bool silhouette).
-    """
-    from radar_cli.masks.detect import detect
-    from radar_cli.masks.pipeline import Settings, check_photo, crop_detection
-
-    check_photo(photo, name)
-    found = detect(photo)
-    if not found:
-        raise InputError(f"{name}: no object stands out from the backdrop; crop it square or use --crop none")
-    crop = crop_detection(photo, found[0], Settings(size=size))
-    return crop.image, crop.box, crop.mask
-
-
 def whole_photo(photo: np.ndarray) -> CropBox:
     """The smallest square window centred on the photo that contains all of it (sides padded)."""
     h, w = photo.shape[:2]
@@ -211,11 +196,20 @@ def _known_mask(item: InputItem, shape: tuple[int, int]) -> np.ndarray | None:
     return mask
 
 
+def _split(silhouette: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A known S x S bool silhouette's symmetric core and appendages."""
+    from radar_cli.masks.appendages import symmetric_core
+
+    parts = symmetric_core(silhouette)
+    return parts.core, parts.appendages
+
+
 def prepare(item: InputItem, size: int, crop: CropMode = "auto", backdrop: Backdrop = "white") -> Prepared:
     """Read a photo and cut the network's input.
 
-    `auto` locates the object and crops around it (from the --masks silhouette if given, else as `radar masks`
-    does); `none` pads the whole photo to a square. Dataset samples are crops already and are used whole.
+    `auto` locates the object in any framing and crops around its symmetric core (masks.locate; from the
+    --masks silhouette if given); `none` pads the whole photo to a square. Dataset samples are crops already and
+    are used whole, with their mask as it is. A transparent cut-out's alpha channel is its silhouette.
 
     Args:
         item: the input.
@@ -227,15 +221,31 @@ def prepare(item: InputItem, size: int, crop: CropMode = "auto", backdrop: Backd
     Returns:
         Prepared; InputError names the file on any problem.
     """
-    photo = read_image(item.image_path, "RGB")
+    from radar_cli.masks.locate import locate_object, split_alpha
+
+    photo = read_image(item.image_path, "RGBA")
     h, w = photo.shape[:2]
     mask = _known_mask(item, (h, w))
     if mask is None and not item.is_crop and crop == "auto":
-        image, box, silhouette = locate(photo, size, str(item.image_path))
-    else:
-        box = whole_photo(photo) if item.is_crop or crop == "none" else square_box(mask_box(mask))  # type: ignore
-        image = cut(photo, box, size)
-        silhouette = None if mask is None else cut(mask.astype(np.uint8) * 255, box, size) > 127
-    if backdrop == "white" and silhouette is not None:
-        return Prepared(white_backdrop(image, silhouette), box, (w, h), "white", silhouette)
-    return Prepared(np.ascontiguousarray(image), box, (w, h), silhouette=silhouette)
+        found = locate_object(photo, size, str(item.image_path))
+        located = Prepared(found.image, found.box, (w, h), silhouette=found.silhouette,
+                           appendages=found.appendages, cut_edges=found.cut_edges,
+                           frame_coverage=round(found.frame_coverage, 4))
+        return _on_backdrop(located, backdrop)
+    rgb, _ = split_alpha(photo)
+    box = whole_photo(rgb) if item.is_crop or crop == "none" else square_box(mask_box(mask))  # type: ignore
+    image = cut(rgb, box, size)
+    silhouette = None if mask is None else cut(mask.astype(np.uint8) * 255, box, size) > 127
+    appendages = None
+    if silhouette is not None and not item.is_crop:
+        silhouette, appendages = _split(silhouette)
+    return _on_backdrop(Prepared(np.ascontiguousarray(image), box, (w, h), silhouette=silhouette,
+                                 appendages=appendages), backdrop)
+
+
+def _on_backdrop(prepared: Prepared, backdrop: Backdrop) -> Prepared:
+    """`white`: the object put on white through its silhouette (appendages whited out with the backdrop)."""
+    if backdrop == "white" and prepared.silhouette is not None:
+        return dataclasses.replace(prepared, image=white_backdrop(prepared.image, prepared.silhouette),
+                                   backdrop="white")
+    return prepared

@@ -16,8 +16,11 @@ from radar_cli.results import (ALBEDO_FILE, ALBEDO_RENDERED_FILE, ENV_PREVIEW_FI
                                NORMAL_RENDERED_FILE, RECON_FILE, RELIT_PREFIX, SUMMARY_FILE, TURNTABLE_GIF_FILE,
                                list_results)
 
-SUMMARY_COLUMNS = ("object", "source", "pitch", "roll", "tx", "ty", "height", "alpha", "rho", "roughness",
-                   "crop_box", "model")
+SUMMARY_COLUMNS = ("object", "status", "reason", "source", "pitch", "roll", "tx", "ty", "height", "alpha", "rho",
+                   "roughness", "crop_box", "model", "silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction",
+                   "cut_edges")
+QUALITY_COLUMNS = ("silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction")
+STATUS_ORDER = {"failed": 0, "review": 1, "ok": 2}  # worst first; objects without a quality record come last
 DECOMPOSITION = ((INPUT_FILE, "input"), (RECON_FILE, "reconstruction"), (ALBEDO_RENDERED_FILE, "albedo"),
                  (NORMAL_RENDERED_FILE, "normals"), (MATERIAL_SPHERE_FILE, "material"),
                  (ENV_PREVIEW_FILE, "lighting"), (TURNTABLE_GIF_FILE, "turntable"))
@@ -38,8 +41,18 @@ def read_records(root: Path) -> list[tuple[str, dict]]:
     return records
 
 
+def by_status(records: list[tuple[str, dict]]) -> list[tuple[str, dict]]:
+    """The records with `failed` first, then `review`, then `ok` (by name within each)."""
+    def rank(item: tuple[str, dict]) -> tuple[int, str]:
+        quality = item[1].get("quality")
+        status = quality.get("status") if isinstance(quality, dict) else None
+        return STATUS_ORDER.get(status, len(STATUS_ORDER)), item[0]
+
+    return sorted(records, key=rank)
+
+
 def write_summary(root: Path, records: list[tuple[str, dict]]) -> None:
-    """summary.csv: one row per object with its pose, shape and material."""
+    """summary.csv: one row per object with its status and quality scores, pose, shape and material."""
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=SUMMARY_COLUMNS, extrasaction="ignore")
     writer.writeheader()
@@ -47,9 +60,14 @@ def write_summary(root: Path, records: list[tuple[str, dict]]) -> None:
         row = {k: rec.get(k, "") for k in SUMMARY_COLUMNS}
         row["object"] = name
         row["crop_box"] = " ".join(str(v) for v in rec.get("crop_box", []))
-        for k in ("pitch", "roll", "tx", "ty", "height", "alpha", "rho", "roughness"):
+        quality = rec.get("quality") if isinstance(rec.get("quality"), dict) else {}
+        row.update({k: quality.get(k) for k in QUALITY_COLUMNS}, status=quality.get("status", ""),
+                   reason="; ".join(quality.get("reasons", [])), cut_edges=" ".join(quality.get("cut_edges", [])))
+        for k in ("pitch", "roll", "tx", "ty", "height", "alpha", "rho", "roughness") + QUALITY_COLUMNS:
             if isinstance(row[k], float):
                 row[k] = f"{row[k]:.4g}"
+            elif row[k] is None:
+                row[k] = ""
         writer.writerow(row)
     write_text(root / SUMMARY_FILE, buf.getvalue())
 
@@ -111,7 +129,7 @@ the recovered material on a sphere, the lighting (environment map), a turntable,
 def write_report(root: str | Path, failures: list[Failure]) -> Path:
     """Write summary.csv, failures.csv and index.html for every complete object under `root`."""
     root = Path(root)
-    records = read_records(root)
+    records = by_status(read_records(root))
     write_summary(root, records)
     write_failures(root, failures)
     return write_index(root, records, len(failures))

@@ -60,6 +60,28 @@ def cut(image: np.ndarray, crop: CropBox, size: int) -> np.ndarray:
     return cv2.resize(window, (size, size), interpolation=interp)
 
 
+def outside_mask(crop: CropBox, image_shape: tuple[int, ...], size: int) -> np.ndarray:
+    """size x size bool: True on the crop's padding (beyond the photo's edge), False on real photo pixels."""
+    u0, v0, u1, v1 = valid_region(crop, image_shape, size)
+    out = np.ones((size, size), bool)
+    out[v0:v1, u0:u1] = False
+    return out
+
+
+def cut_edges(mask: np.ndarray, region: tuple[int, int, int, int], min_run: float = 0.02) -> tuple[str, ...]:
+    """The photo edges (`top`, `bottom`, `left`, `right`) that cut the object: where the bool crop mask runs
+    along the edge of `region` (u0, v0, u1, v1: the crop's real photo pixels) for at least `min_run` of the
+    crop's side. A crop framed around the whole object never reaches its own edges, so an edge of the region
+    that the object touches is the photo's."""
+    u0, v0, u1, v1 = region
+    if u1 - u0 < 2 or v1 - v0 < 2:
+        return ()
+    inner = mask[v0:v1, u0:u1]
+    need = max(1, int(min_run * mask.shape[0]))
+    lines = {"top": inner[0], "bottom": inner[-1], "left": inner[:, 0], "right": inner[:, -1]}
+    return tuple(name for name, line in lines.items() if int(line.sum()) >= need)
+
+
 def crop_affine(crop: CropBox, size: int, scale: float = 1.0) -> np.ndarray:
     """2 x 3 affine taking pixel centres of an image at `scale` x the original's resolution into the crop's
     size x size pixel grid."""

@@ -5,6 +5,11 @@ fitted robustly to a band along the image border; a pixel's distance from that m
 own noise, says how unlike the backdrop it is. Edges and spectral-residual saliency (opencv-contrib) add
 evidence where the object's colour is close to the backdrop. Connected components that are large enough become
 instances, one per object.
+
+Where the object fills much of the frame (a tight crop, a vessel touching the top and bottom edges) the border
+model is extrapolated over a backdrop it has barely seen; a GrabCut pass over the whole downscaled photo,
+seeded by that evidence (border pixels that fit the model are sure backdrop), learns the backdrop's colours from
+all of it and decides the object's pixels.
 """
 
 from __future__ import annotations
@@ -18,7 +23,9 @@ WORK_SIDE = 320  # detection runs at this long edge; refinement happens later at
 BORDER_FRAC = 0.04  # width of the border band the backdrop is fitted to, as a fraction of the long edge
 MIN_AREA_FRAC = 0.01  # components smaller than this fraction of the image are noise (labels, dust)
 MIN_REL_AREA = 0.2  # ... and components smaller than this fraction of the largest one are dropped too
-GROUP_GAP = 0.03  # components whose boxes come this close (fraction of the long edge) are one object
+GROUP_GAP = 0.03  # components whose boxes come this close (fraction of the long edge) are one object ...
+GROUP_OVERLAP = 0.5  # ... if they also share this fraction of the narrower one's width (a label beside it: not)
+COARSE_ITERATIONS = 4  # GrabCut iterations of the whole-photo pass
 LIGHT_RANGE = (0.2, 1.6)  # brightness ratios to the backdrop model that shading of the backdrop can explain
 
 
@@ -181,6 +188,38 @@ def foreground_evidence(image: np.ndarray) -> np.ndarray:
     return np.clip(colour + extra * (colour > 0.15), 0.0, 1.0)
 
 
+def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float) -> np.ndarray:
+    """H x W bool object pixels of a detection-scale photo: GrabCut over the whole image, started from the
+    evidence (above `threshold`, holes filled: probable object; in the border band and below a third of it: sure
+    backdrop; elsewhere probable backdrop). Falls back to the thresholded evidence if GrabCut cannot run or
+    breaks the object up.
+
+    Args:
+        image: H x W x 3 uint8 RGB. evidence: H x W in [0, 1] (`foreground_evidence`).
+    """
+    raw = evidence > threshold
+    tri = np.full(raw.shape, cv2.GC_PR_BGD, np.uint8)
+    tri[_clean(raw)] = cv2.GC_PR_FGD  # holes filled: a flat object seen only by its outline is object inside
+    tri[border_band(raw.shape) & (evidence < threshold / 3)] = cv2.GC_BGD
+    if not raw.any() or not (tri == cv2.GC_BGD).any():
+        return raw
+    bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
+    try:
+        cv2.grabCut(np.ascontiguousarray(image), tri, None, bgd, fgd, COARSE_ITERATIONS, cv2.GC_INIT_WITH_MASK)
+    except cv2.error:
+        return raw
+    cut = (tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)
+    # GrabCut trims backdrop that the evidence took for object; if it breaks the object up instead (a flat
+    # object seen only by its outline), the evidence stands
+    return cut if _largest_area(_clean(cut)) >= 0.5 * _largest_area(_clean(raw)) else raw
+
+
+def _largest_area(mask: np.ndarray) -> int:
+    """Pixels in the largest 8-connected component of a bool mask (0 if empty)."""
+    n, _, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
+    return int(stats[1:, cv2.CC_STAT_AREA].max()) if n > 1 else 0
+
+
 def _clean(mask: np.ndarray) -> np.ndarray:
     """Close small gaps, fill holes (flood from the border), open away specks."""
     side = max(mask.shape)
@@ -207,8 +246,9 @@ def fill_holes(mask: np.ndarray, max_hole_frac: float = 1.0) -> np.ndarray:
 
 
 def _groups(boxes: list[tuple[int, int, int, int]], gap: float) -> list[list[int]]:
-    """Indices of boxes (x0, y0, x1, y1) grouped transitively when they come within `gap` px of each other:
-    the pieces of one object that the threshold split apart."""
+    """Indices of boxes (x0, y0, x1, y1) grouped transitively when they come within `gap` px of each other
+    vertically and share most of the narrower one's width: the pieces of one object that the threshold split
+    apart (a label or colour chart beside the object stays apart)."""
     group = list(range(len(boxes)))
 
     def root(i: int) -> int:
@@ -219,7 +259,9 @@ def _groups(boxes: list[tuple[int, int, int, int]], gap: float) -> list[list[int
     for i, a in enumerate(boxes):
         for j in range(i):
             b = boxes[j]
-            if a[0] - gap < b[2] and b[0] - gap < a[2] and a[1] - gap < b[3] and b[1] - gap < a[3]:
+            shared = min(a[2], b[2]) - max(a[0], b[0])
+            narrower = max(1, min(a[2] - a[0], b[2] - b[0]))
+            if (shared >= GROUP_OVERLAP * narrower and a[1] - gap < b[3] and b[1] - gap < a[3]):
                 group[root(i)] = root(j)
     out: dict[int, list[int]] = {}
     for i in range(len(boxes)):
@@ -239,7 +281,7 @@ def detect(image: np.ndarray, threshold: float = 0.5) -> list[Detection]:
     """
     small, scale = downscale(image)
     evidence = foreground_evidence(small)
-    raw = evidence > threshold
+    raw = coarse_grabcut(small, evidence, threshold)
     mask = _clean(raw)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     if n <= 1:

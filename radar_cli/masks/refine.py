@@ -25,10 +25,10 @@ def _disk(radius: int) -> np.ndarray:
     return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (d, d))
 
 
-def trimap(rough: np.ndarray, sure: np.ndarray | None = None) -> np.ndarray:
+def trimap(rough: np.ndarray, sure: np.ndarray | None = None, outside: np.ndarray | None = None) -> np.ndarray:
     """GrabCut's 4-level mask from a rough bool mask: definite foreground deep inside (and only where `sure`,
     if given), probable foreground and probable background in bands either side of the outline, definite
-    background beyond."""
+    background beyond and in `outside` (padding beyond the photo's edge)."""
     m = rough.astype(np.uint8)
     size = np.sqrt(max(int(m.sum()), 1))
     inner = cv2.erode(m, _disk(round(INNER_BAND * size))) > 0
@@ -39,6 +39,8 @@ def trimap(rough: np.ndarray, sure: np.ndarray | None = None) -> np.ndarray:
     tri[outer] = cv2.GC_PR_BGD
     tri[rough] = cv2.GC_PR_FGD
     tri[inner] = cv2.GC_FGD
+    if outside is not None:
+        tri[outside] = cv2.GC_BGD
     return tri
 
 
@@ -92,20 +94,31 @@ def snap_edges(image: np.ndarray, mask: np.ndarray, band: int = 2, sigma: float 
     return out
 
 
-def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4,
-           sure: np.ndarray | None = None) -> tuple[np.ndarray, bool]:
+def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4, sure: np.ndarray | None = None,
+           outside: np.ndarray | None = None) -> tuple[np.ndarray, bool]:
     """Refine a rough mask with GrabCut.
 
     Args:
         image: S x S x 3 uint8 RGB crop.
         rough: S x S bool rough mask (from the detector, warped into the crop).
         sure: S x S bool, where the detector saw the object itself (not a filled hole); None = everywhere.
+        outside: S x S bool, the padding beyond the photo's edge: never object (an object cut by the frame
+            ends there); None = none.
         iterations: GrabCut iterations.
 
     Returns:
         (mask S x S bool, used_grabcut): the cleaned mask; False if GrabCut failed or disagreed with the
         rough mask so much that the rough mask was kept (still cleaned).
     """
+    if outside is not None:
+        rough = rough & ~outside
+    mask, used = _refine(image, rough, iterations, sure, outside)
+    return (mask & ~outside if outside is not None else mask), used
+
+
+def _refine(image: np.ndarray, rough: np.ndarray, iterations: int, sure: np.ndarray | None,
+            outside: np.ndarray | None) -> tuple[np.ndarray, bool]:
+    """`refine` inside the photo (the caller clips the result to it)."""
     sigma = max(0.6, image.shape[0] / 256.0)
     if rough.sum() < 16:
         return clean(rough, sigma), False
@@ -115,7 +128,9 @@ def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4,
     gc_rough = cv2.resize(rough.astype(np.uint8), gc_img.shape[1::-1], interpolation=cv2.INTER_NEAREST) > 0
     gc_sure = None if sure is None else cv2.resize(sure.astype(np.uint8), gc_img.shape[1::-1],
                                                   interpolation=cv2.INTER_NEAREST) > 0
-    tri = trimap(gc_rough, gc_sure)
+    gc_outside = None if outside is None else cv2.resize(outside.astype(np.uint8), gc_img.shape[1::-1],
+                                                         interpolation=cv2.INTER_NEAREST) > 0
+    tri = trimap(gc_rough, gc_sure, gc_outside)
     if not (tri == cv2.GC_FGD).any() or not (tri == cv2.GC_BGD).any():
         return clean(rough, sigma), False
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
