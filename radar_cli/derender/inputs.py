@@ -221,17 +221,13 @@ def prepare(item: InputItem, size: int, crop: CropMode = "auto", backdrop: Backd
     Returns:
         Prepared; InputError names the file on any problem.
     """
-    from radar_cli.masks.locate import locate_object, split_alpha
+    from radar_cli.masks.locate import split_alpha
 
     photo = read_image(item.image_path, "RGBA")
     h, w = photo.shape[:2]
     mask = _known_mask(item, (h, w))
     if mask is None and not item.is_crop and crop == "auto":
-        found = locate_object(photo, size, str(item.image_path))
-        located = Prepared(found.image, found.box, (w, h), silhouette=found.silhouette,
-                           appendages=found.appendages, cut_edges=found.cut_edges,
-                           frame_coverage=round(found.frame_coverage, 4))
-        return _on_backdrop(located, backdrop)
+        return located_input(photo, size, str(item.image_path), backdrop)
     rgb, _ = split_alpha(photo)
     box = whole_photo(rgb) if item.is_crop or crop == "none" else square_box(mask_box(mask))  # type: ignore
     image = cut(rgb, box, size)
@@ -241,6 +237,17 @@ def prepare(item: InputItem, size: int, crop: CropMode = "auto", backdrop: Backd
         silhouette, appendages = _split(silhouette)
     return _on_backdrop(Prepared(np.ascontiguousarray(image), box, (w, h), silhouette=silhouette,
                                  appendages=appendages), backdrop)
+
+
+def located_input(photo: np.ndarray, size: int, name: str, backdrop: Backdrop = "white") -> Prepared:
+    """The network's input from a photo (H x W x 3 RGB or x 4 RGBA) whose object is located (masks.locate)."""
+    from radar_cli.masks.locate import locate_object
+
+    found = locate_object(photo, size, name)
+    h, w = photo.shape[:2]
+    located = Prepared(found.image, found.box, (w, h), silhouette=found.silhouette, appendages=found.appendages,
+                       cut_edges=found.cut_edges, frame_coverage=round(found.frame_coverage, 4))
+    return _on_backdrop(located, backdrop)
 
 
 def _on_backdrop(prepared: Prepared, backdrop: Backdrop) -> Prepared:

@@ -23,17 +23,17 @@ class QualityLimits:
 
     fail_coverage: float = 0.9
     """A located object covering this share of the photo is the backdrop, not an object: failed."""
-    fail_iou: float = 0.6
+    fail_iou: float = 0.5
     """Rendered vs located silhouette IoU below this: the solid does not explain the object: failed."""
     min_area: float = 0.02
     """A located silhouette under this share of the crop is too small to de-render: failed."""
-    review_iou: float = 0.85
+    review_iou: float = 0.75
     """Rendered vs located silhouette IoU below this: review."""
     review_symmetry: float = 0.8
     """Solid-of-revolution score of the core below this: review (not a vessel of revolution?)."""
     review_appendage: float = 0.2
     """More than this share of the located object left out as appendage: review."""
-    review_psnr: float = 13.0
+    review_psnr: float = 10.0
     """Reconstruction PSNR (dB) inside the silhouette below this: review."""
     review_cut_edges: int = 3
     """An object running into this many photo edges or more: review (the photo may not show all of it)."""

@@ -21,6 +21,7 @@ from radar_cli.masks.refine import main_component
 SIDE_TOLERANCE = 0.03  # a half-width may exceed the other by this fraction of the object's width (perspective)
 BUMP_SPAN = 0.1  # bumps of the radius profile shorter than this fraction of the height are appendages
 NEAR_AXIS = 0.05  # a row whose runs all miss the axis keeps the nearest one within this fraction of the width
+END_ROWS = 0.04  # ... unless they reach this close (fraction of the height) to the top or bottom: a rim, a foot
 MIN_APPENDAGE = 0.004  # appendage parts smaller than this fraction of the silhouette are outline noise
 
 
@@ -106,14 +107,15 @@ def _opening(profile: np.ndarray, span: int) -> np.ndarray:
 
 
 def _keep_ends(radius: np.ndarray, opened: np.ndarray, tol: float, rows: np.ndarray) -> np.ndarray:
-    """The opened profile, except over bumps that reach the first or last row: a rim or a foot is the solid's
-    own, a handle's attachment lies between body rows."""
+    """The opened profile, except over bumps that start or end within `END_ROWS` of the first or last row: a
+    rim or a foot is the solid's own, a handle's attachment lies between body rows."""
     out = opened.copy()
     bump = np.zeros(len(radius) + 2, np.int8)
     bump[1:-1] = np.nan_to_num(radius, nan=0.0) > opened + tol
     edges = np.diff(bump)
+    near = END_ROWS * (rows.max() - rows.min() + 1)
     for start, end in zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]):
-        if start <= rows.min() + 1 or end >= rows.max():
+        if start <= rows.min() + near or end >= rows.max() - near:
             out[start:end] = radius[start:end]
     return out
 

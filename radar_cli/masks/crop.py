@@ -44,8 +44,9 @@ def square_box(box: tuple[float, float, float, float], margin: float = DEFAULT_M
     return CropBox(int(round(cx - side / 2.0)), int(round(cy - side / 2.0)), side)
 
 
-def cut(image: np.ndarray, crop: CropBox, size: int) -> np.ndarray:
-    """The crop of an H x W (x C) image, resized to size x size; outside the photo the edge is replicated.
+def cut(image: np.ndarray, crop: CropBox, size: int, fill: float | None = None) -> np.ndarray:
+    """The crop of an H x W (x C) image, resized to size x size; outside the photo the edge is replicated, or
+    filled with the value `fill` if given.
 
     Returns:
         size x size (x C), same dtype.
@@ -55,7 +56,8 @@ def cut(image: np.ndarray, crop: CropBox, size: int) -> np.ndarray:
     pad = (max(0, -y0), max(0, y1 - h), max(0, -x0), max(0, x1 - w))
     window = image[max(0, y0) : min(h, y1), max(0, x0) : min(w, x1)]
     if any(pad):
-        window = cv2.copyMakeBorder(window, *pad, borderType=cv2.BORDER_REPLICATE)
+        window = (cv2.copyMakeBorder(window, *pad, borderType=cv2.BORDER_REPLICATE) if fill is None else
+                  cv2.copyMakeBorder(window, *pad, borderType=cv2.BORDER_CONSTANT, value=[fill] * 4))
     interp = cv2.INTER_AREA if crop.side > size else cv2.INTER_LINEAR
     return cv2.resize(window, (size, size), interpolation=interp)
 

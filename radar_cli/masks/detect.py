@@ -26,6 +26,9 @@ MIN_REL_AREA = 0.2  # ... and components smaller than this fraction of the large
 GROUP_GAP = 0.03  # components whose boxes come this close (fraction of the long edge) are one object ...
 GROUP_OVERLAP = 0.5  # ... if they also share this fraction of the narrower one's width (a label beside it: not)
 COARSE_ITERATIONS = 4  # GrabCut iterations of the whole-photo pass
+SEED_SHARE = 0.5  # the backdrop's colour surface is refitted to this best-fitting share of the border band ...
+SEED_ROUNDS = 3  # ... this many times
+SEED_MIN_TOLERANCE = 8.0  # band pixels this close (RGB levels) to that surface are backdrop whatever its spread
 LIGHT_RANGE = (0.2, 1.6)  # brightness ratios to the backdrop model that shading of the backdrop can explain
 
 
@@ -190,18 +193,21 @@ def foreground_evidence(image: np.ndarray) -> np.ndarray:
 
 def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float) -> np.ndarray:
     """H x W bool object pixels of a detection-scale photo: GrabCut over the whole image, started from the
-    evidence (above `threshold`, holes filled: probable object; in the border band and below a third of it: sure
-    backdrop; elsewhere probable backdrop). Falls back to the thresholded evidence if GrabCut cannot run or
+    evidence (above `threshold`, holes filled: probable object; a thin ring around it: probable backdrop;
+    beyond it and `backdrop_seeds` in the border band: sure backdrop). Falls back to the thresholded evidence if GrabCut cannot run or
     breaks the object up.
 
     Args:
         image: H x W x 3 uint8 RGB. evidence: H x W in [0, 1] (`foreground_evidence`).
     """
     raw = evidence > threshold
-    tri = np.full(raw.shape, cv2.GC_PR_BGD, np.uint8)
-    tri[_clean(raw)] = cv2.GC_PR_FGD  # holes filled: a flat object seen only by its outline is object inside
-    tri[border_band(raw.shape) & (evidence < threshold / 3)] = cv2.GC_BGD
-    if not raw.any() or not (tri == cv2.GC_BGD).any():
+    seed = _clean(raw)  # holes filled: a flat object seen only by its outline is object inside
+    reach = cv2.dilate(seed.astype(np.uint8), np.ones((5, 5), np.uint8)) > 0
+    tri = np.full(raw.shape, cv2.GC_BGD, np.uint8)  # GrabCut trims what the evidence took, it never adds
+    tri[reach] = cv2.GC_PR_BGD
+    tri[seed] = cv2.GC_PR_FGD
+    tri[backdrop_seeds(image)] = cv2.GC_BGD
+    if not raw.any():
         return raw
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
     try:
@@ -209,9 +215,34 @@ def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float) ->
     except cv2.error:
         return raw
     cut = (tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)
-    # GrabCut trims backdrop that the evidence took for object; if it breaks the object up instead (a flat
+    # GrabCut trims backdrop that the evidence took for object; if it breaks a modest object up instead (a flat
     # object seen only by its outline), the evidence stands
-    return cut if _largest_area(_clean(cut)) >= 0.5 * _largest_area(_clean(raw)) else raw
+    broken = _largest_area(_clean(cut)) < 0.5 * _largest_area(seed) and seed.mean() < 0.5
+    return raw if broken else cut
+
+
+def backdrop_seeds(image: np.ndarray) -> np.ndarray:
+    """H x W bool border-band pixels that are surely backdrop: those that a quadratic colour surface, fitted to
+    the band's best-fitting half, explains. An object running into the band is the minority there and is left
+    out, even where the border model (which carries the whole band's residuals inwards) took it for backdrop.
+
+    Args:
+        image: H x W x 3 uint8 RGB.
+    """
+    band = border_band(image.shape[:2])
+    h, w = band.shape
+    ys, xs = np.nonzero(band)
+    a = _design(xs / max(w - 1, 1) * 2 - 1.0, ys / max(h - 1, 1) * 2 - 1.0).astype(np.float64)  # N x 6
+    values = image[ys, xs].astype(np.float64)  # N x 3
+    keep = np.ones(len(ys), bool)
+    for _ in range(SEED_ROUNDS):
+        coef = np.linalg.lstsq(a[keep], values[keep], rcond=None)[0]  # 6 x 3
+        resid = np.linalg.norm(values - a @ coef, axis=1)
+        keep = resid <= np.quantile(resid, SEED_SHARE)
+    fits = resid <= max(3.0 * 1.4826 * float(np.median(resid[keep])), SEED_MIN_TOLERANCE)
+    seeds = np.zeros(band.shape, bool)
+    seeds[ys[fits], xs[fits]] = True
+    return seeds
 
 
 def _largest_area(mask: np.ndarray) -> int:

@@ -21,6 +21,7 @@ CUTOUT_MIN_CLEAR = 0.01  # an alpha channel with at least this share of clear pi
 STAND_MIN, STAND_MAX = 0.03, 0.45  # a stand's height as a fraction of the located height
 STAND_STEP = 0.08  # ... whose width differs from the vessel's foot above it by at least this fraction
 STAND_TOLERANCE = 0.015  # straight sides: the stand's edges move less than this fraction of the window per row
+STAND_COLOUR_STEP = 30.0  # ... and whose mean colour is this far (RGB levels) from the vessel's above it
 
 
 @dataclass(frozen=True)
@@ -77,11 +78,12 @@ def alpha_detection(opaque: np.ndarray) -> Detection:
     return Detection(mask, box, 1.0, scale)
 
 
-def alpha_refined(opaque: np.ndarray, found: Detection, settings: Settings) -> Refined:
+def alpha_refined(rgb: np.ndarray, opaque: np.ndarray, found: Detection, settings: Settings) -> Refined:
     """The cut-out's own silhouette in the refinement window (no GrabCut: the alpha channel is the answer)."""
     window, work_side = refine_window(found, settings)
     mask = main_component(crops.warp_mask(opaque, crops.crop_affine(window, work_side), work_side))
-    return Refined(mask, window, crops.outside_mask(window, opaque.shape, work_side), False)
+    return Refined(mask, window, crops.outside_mask(window, opaque.shape, work_side), False,
+                   crops.cut(rgb, window, work_side))
 
 
 def _extents(mask: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -93,37 +95,42 @@ def _extents(mask: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return left, right
 
 
-def remove_stand(mask: np.ndarray, outside: np.ndarray) -> tuple[np.ndarray, bool]:
-    """Cut a stand off the bottom of a located object: rows reaching the photo's bottom edge with straight
-    sides, a few percent to under half the object's height, clearly wider or narrower than the vessel's foot.
+def remove_stand(mask: np.ndarray, image: np.ndarray) -> tuple[np.ndarray, bool]:
+    """Cut a stand off the bottom of a located object: the bottom rows with straight sides, a few percent to
+    under half the object's height, clearly wider or narrower than the vessel's foot above them and of another
+    colour (a vessel's own foot ring is of its glaze; a straight vessel cut by the frame has no step).
 
     Args:
-        mask: n x n bool located object. outside: n x n bool padding beyond the photo's edge.
+        mask: n x n bool located object. image: n x n x 3 uint8, the pixels it was located in.
 
     Returns:
         (mask without the stand, whether one was removed).
     """
-    inside_rows = np.nonzero(~outside.all(1))[0]
     rows = np.nonzero(mask.any(1))[0]
-    if len(rows) < 10 or len(inside_rows) == 0 or rows.max() != inside_rows.max():
+    if len(rows) < 10:
         return mask, False
     height = rows.max() - rows.min() + 1
     left, right = _extents(mask, rows)
+    widths = right - left + 1
+    while len(rows) > 10 and widths[-1] < 0.5 * np.median(widths[-10:]):  # a ragged sliver under the stand
+        rows, left, right, widths = rows[:-1], left[:-1], right[:-1], widths[:-1]
     tol = max(1.5, STAND_TOLERANCE * mask.shape[0])
     k = len(rows) - 1
     while k > 0 and abs(left[k - 1] - left[-1]) <= tol and abs(right[k - 1] - right[-1]) <= tol:
         k -= 1
     span = len(rows) - k
-    above = slice(max(0, k - 4), k)
-    if not (STAND_MIN * height <= span <= STAND_MAX * height) or k == 0:
+    if not (STAND_MIN * height <= span <= STAND_MAX * height) or k < span:
         return mask, False
     stand_w = right[-1] - left[-1] + 1
-    foot_w = float(np.mean(right[above] - left[above] + 1))
-    if abs(foot_w - stand_w) < STAND_STEP * stand_w:
+    foot_w = float(np.mean(right[k - 4 : k] - left[k - 4 : k] + 1))
+    stand, above = mask.copy(), mask.copy()
+    stand[: rows[k]] = False
+    above[: rows[k - span]] = False
+    above[rows[k]:] = False
+    colour_step = np.linalg.norm(image[stand].mean(0) - image[above].mean(0))
+    if abs(foot_w - stand_w) < STAND_STEP * stand_w or colour_step < STAND_COLOUR_STEP:
         return mask, False
-    out = mask.copy()
-    out[rows[k]:] = False
-    return main_component(out), True
+    return main_component(mask & ~stand), True
 
 
 def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: float = crops.DEFAULT_MARGIN) -> Located:
@@ -143,16 +150,16 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     settings = Settings(size=size, margin=margin)
     if opaque is not None:
         found = alpha_detection(opaque)
-        refined = alpha_refined(opaque, found, settings)
+        refined = alpha_refined(rgb, opaque, found, settings)
     else:
         detections = detect(rgb)
         if not detections:
             raise InputError(f"{name}: no object stands out from the backdrop; crop it square or use --crop none")
         found = detections[0]
         refined = refine_detection(rgb, found, settings)
-    mask, stand = remove_stand(refined.mask, refined.outside)
+    mask, stand = remove_stand(refined.mask, refined.image)
     split: Core = symmetric_core(mask)
-    final, image, core = refined.framed(rgb, split.core, settings)
+    final, image, core = refined.framed(rgb, split.core, settings, fill=255)  # beyond the frame: white
     _, _, whole = refined.framed(rgb, mask, settings, box_mask=split.core)
     region = crops.valid_region(final, rgb.shape, size)
     k = refined.window.side / mask.shape[0]

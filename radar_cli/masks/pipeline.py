@@ -103,17 +103,18 @@ class Refined:
         window: the square window of the photo it covers (may reach beyond the photo's edge).
         outside: n x n bool, the window's padding beyond the photo's edge.
         grabcut: whether GrabCut's answer was kept.
+        image: n x n x 3 uint8, the window's pixels.
     """
 
     mask: np.ndarray
     window: crops.CropBox
     outside: np.ndarray
     grabcut: bool
-
-    def framed(self, image: np.ndarray, mask: np.ndarray, settings: Settings,
-               box_mask: np.ndarray | None = None) -> tuple[crops.CropBox, np.ndarray, np.ndarray]:
+    image: np.ndarray
+    def framed(self, image: np.ndarray, mask: np.ndarray, settings: Settings, box_mask: np.ndarray | None = None,
+               fill: float | None = None) -> tuple[crops.CropBox, np.ndarray, np.ndarray]:
         """The final square crop around `box_mask` (default `mask`; n x n bool in this window): (its box in the
-        photo, size x size x 3 uint8 image, `mask` cut to size x size bool)."""
+        photo, size x size x 3 uint8 image padded as `crops.cut` with `fill`, `mask` cut to size x size bool)."""
         n = self.mask.shape[0]
         box = crops.mask_box(mask if box_mask is None else box_mask) or (0, 0, n, n)
         k = self.window.side / n  # photo pixels per work pixel
@@ -122,7 +123,7 @@ class Refined:
                                  settings.margin)
         to_final = crops.crop_affine(final, settings.size, 1.0 / k) @ np.vstack(
             [[1, 0, w.x0 / k], [0, 1, w.y0 / k], [0, 0, 1]])
-        return final, crops.cut(image, final, settings.size), crops.warp_mask(mask, to_final, settings.size)
+        return final, crops.cut(image, final, settings.size, fill), crops.warp_mask(mask, to_final, settings.size)
 
 
 def refine_window(found: Detection, settings: Settings) -> tuple[crops.CropBox, int]:
@@ -153,7 +154,7 @@ def refine_detection(image: np.ndarray, found: Detection, settings: Settings) ->
     mask, used_grabcut = refine(work_img, rough, sure=sure, outside=outside)
     if not mask.any():
         mask = rough & ~outside if (rough & ~outside).any() else ~outside
-    return Refined(mask, window, outside, used_grabcut)
+    return Refined(mask, window, outside, used_grabcut, work_img)
 
 
 def crop_detection(image: np.ndarray, found: Detection, settings: Settings) -> Crop:

@@ -31,7 +31,8 @@ def trimap(rough: np.ndarray, sure: np.ndarray | None = None, outside: np.ndarra
     background beyond and in `outside` (padding beyond the photo's edge)."""
     m = rough.astype(np.uint8)
     size = np.sqrt(max(int(m.sum()), 1))
-    inner = cv2.erode(m, _disk(round(INNER_BAND * size))) > 0
+    grown = m if outside is None else (rough | outside).astype(np.uint8)  # the frame's edge is no outline
+    inner = (cv2.erode(grown, _disk(round(INNER_BAND * size))) > 0) & rough
     if sure is not None:
         inner &= cv2.erode(sure.astype(np.uint8), _disk(1)) > 0
     outer = cv2.dilate(m, _disk(round(OUTER_BAND * size))) > 0
@@ -59,10 +60,13 @@ def smooth_boundary(mask: np.ndarray, sigma: float) -> np.ndarray:
     return cv2.GaussianBlur(mask.astype(np.float32), (0, 0), sigma) > 0.5
 
 
-def clean(mask: np.ndarray, sigma: float) -> np.ndarray:
-    """Fill small holes, keep the main component, smooth the outline."""
+def clean(mask: np.ndarray, sigma: float, outside: np.ndarray | None = None) -> np.ndarray:
+    """Fill small holes, keep the main component, smooth the outline (not along `outside`, the padding beyond
+    the photo's edge: an object cut by the frame keeps its straight cut)."""
     m = main_component(fill_holes(mask, MAX_HOLE_FRAC))
-    return main_component(smooth_boundary(m, sigma))
+    if outside is None:
+        return main_component(smooth_boundary(m, sigma))
+    return main_component(smooth_boundary(m | outside, sigma) & ~outside)
 
 
 def snap_edges(image: np.ndarray, mask: np.ndarray, band: int = 2, sigma: float = 3.0) -> np.ndarray:
@@ -140,8 +144,11 @@ def _refine(image: np.ndarray, rough: np.ndarray, iterations: int, sure: np.ndar
         return clean(rough, sigma), False
     cut = ((tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)).astype(np.float32)
     cut = cv2.resize(cut, (side, side), interpolation=cv2.INTER_LINEAR) > 0.5
-    cut = snap_edges(image, cut, band=max(2, round(1.5 / small)))
-    refined = clean(cut, sigma)
+    if outside is None:
+        cut = snap_edges(image, cut, band=max(2, round(1.5 / small)))
+    else:
+        cut = snap_edges(image, cut | outside, band=max(2, round(1.5 / small))) & ~outside
+    refined = clean(cut, sigma, outside)
     if iou(refined, rough) < MIN_AGREEMENT:
         return clean(rough, sigma), False
     return refined, True

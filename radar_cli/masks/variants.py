@@ -183,7 +183,8 @@ def make_variant(kind: str, photo: np.ndarray, mask: np.ndarray, rng: np.random.
 
 
 def with_handles(photo: np.ndarray, mask: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """A vase given two loop handles (an amphora's), drawn in its own colour on both sides.
+    """A vase given two loop handles (an amphora's), drawn in its own colour on both sides, each joining the
+    body at two heights.
 
     Returns:
         (H x W x 3 uint8 photo, H x W bool silhouette with the handles); the input mask is the core's truth.
@@ -193,20 +194,20 @@ def with_handles(photo: np.ndarray, mask: np.ndarray, rng: np.random.Generator) 
     ya = y0 + int(rng.uniform(0.12, 0.3) * height)
     yb = ya + int(rng.uniform(0.25, 0.4) * height)
     thick = max(2, int(rng.uniform(0.03, 0.05) * height))
-    reach = int(rng.uniform(0.12, 0.22) * (x1 - x0))
-    colour = np.median(photo[mask], axis=0)
-    colour = tuple(float(c) for c in colour * rng.uniform(0.7, 0.9))
-    handles = np.zeros(mask.shape, np.uint8)
-    img = photo.copy()
+    reach = rng.uniform(0.12, 0.22) * (x1 - x0)
+    colour = tuple(float(c) for c in np.median(photo[mask], axis=0) * rng.uniform(0.7, 0.9))
+    layer = np.zeros(mask.shape, np.uint8)
+    t = np.linspace(0.0, 1.0, 40)[:, None]
     for side in (-1, 1):
-        rows = [ya, yb]
-        edge = [np.nonzero(mask[y])[0] for y in rows]
-        xs = [(e.max() if side > 0 else e.min()) if len(e) else (x1 if side > 0 else x0) for e in edge]
-        cx, cy = int(max(xs) if side > 0 else min(xs)), (ya + yb) // 2
-        start, end = (-90, 90) if side > 0 else (90, 270)
-        layer = np.zeros(mask.shape, np.uint8)
-        cv2.ellipse(layer, (cx - side * thick, cy), (reach, (yb - ya) // 2), 0, start, end, 1, thick)
-        handles |= layer
-    handles = (handles > 0) & ~mask
+        ends = []
+        for y in (ya, yb):
+            xs = np.nonzero(mask[y])[0]
+            edge = (xs.max() if side > 0 else xs.min()) if len(xs) else (x1 if side > 0 else x0)
+            ends.append(np.array([edge - side * thick, y], float))
+        apex = np.array([(x1 if side > 0 else x0) + side * 2 * reach, (ya + yb) / 2])
+        curve = (1 - t) ** 2 * ends[0] + 2 * t * (1 - t) * apex + t**2 * ends[1]  # quadratic Bezier, 40 x 2
+        cv2.polylines(layer, [np.round(curve).astype(np.int32)], False, 1, thick)
+    handles = (layer > 0) & ~mask
+    img = photo.copy()
     img[handles] = colour
     return img, mask | handles
