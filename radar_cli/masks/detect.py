@@ -26,6 +26,7 @@ MIN_REL_AREA = 0.2  # ... and components smaller than this fraction of the large
 GROUP_GAP = 0.03  # components whose boxes come this close (fraction of the long edge) are one object ...
 GROUP_OVERLAP = 0.5  # ... if they also share this fraction of the narrower one's width (a label beside it: not)
 COARSE_ITERATIONS = 4  # GrabCut iterations of the whole-photo pass
+RING = 0.03  # the second backdrop model leaves out this much (fraction of the long edge) around the object
 SEED_SHARE = 0.5  # the backdrop's colour surface is refitted to this best-fitting share of the border band ...
 SEED_ROUNDS = 3  # ... this many times
 SEED_MIN_TOLERANCE = 8.0  # band pixels this close (RGB levels) to that surface are backdrop whatever its spread
@@ -181,10 +182,15 @@ def saliency_map(image: np.ndarray) -> np.ndarray:
     return smap / max(float(smap.max()), 1e-6)
 
 
-def foreground_evidence(image: np.ndarray) -> np.ndarray:
+def foreground_evidence(image: np.ndarray, band: np.ndarray | None = None) -> np.ndarray:
     """H x W evidence in [0, 1] that a pixel is not backdrop: colour distance, plus edges and saliency near the
-    threshold (they can lift a low-contrast pixel over it, never create an object alone)."""
-    band = border_band(image.shape[:2])
+    threshold (they can lift a low-contrast pixel over it, never create an object alone).
+
+    Args:
+        image: H x W x 3 uint8 RGB.
+        band: H x W bool, the pixels the backdrop is modelled from (default: the border band).
+    """
+    band = border_band(image.shape[:2]) if band is None else band
     dist = backdrop_distance(image, band)
     colour = 1.0 - np.exp(-((dist / 6.0) ** 2))  # ~0.63 at 6 sigma
     extra = 0.25 * edge_map(image).clip(0, 1) + 0.15 * saliency_map(image)
@@ -243,6 +249,11 @@ def backdrop_seeds(image: np.ndarray) -> np.ndarray:
     seeds = np.zeros(band.shape, bool)
     seeds[ys[fits], xs[fits]] = True
     return seeds
+
+
+def _square(side: float) -> np.ndarray:
+    k = max(3, int(round(side)) | 1)
+    return np.ones((k, k), np.uint8)
 
 
 def _largest_area(mask: np.ndarray) -> int:
@@ -313,6 +324,11 @@ def detect(image: np.ndarray, threshold: float = 0.5) -> list[Detection]:
     small, scale = downscale(image)
     evidence = foreground_evidence(small)
     raw = coarse_grabcut(small, evidence, threshold)
+    if raw.any():  # the backdrop seen all round the object, not only at the border: vignettes, light pools
+        clear = ~(cv2.dilate(_clean(raw).astype(np.uint8), _square(RING * max(raw.shape))) > 0)
+        if clear.mean() > RING:
+            evidence = foreground_evidence(small, clear | border_band(raw.shape))
+            raw = coarse_grabcut(small, evidence, threshold)
     mask = _clean(raw)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     if n <= 1:

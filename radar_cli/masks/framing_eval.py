@@ -104,8 +104,49 @@ def evaluate(sources: list[tuple[str, np.ndarray, np.ndarray]], seed: int,
     return results, items
 
 
+BROKEN = ("whole_frame", "shifted")  # silhouettes spoilt on purpose: what the status must not call ok
+
+
+def spoilt_input(kind: str, variant: Variant, size: int):
+    """The network's input of a variant with a wrong silhouette: `whole_frame` (no object located: the whole
+    photo padded square, its silhouette the frame) or `shifted` (the located core moved sideways by a fifth of
+    its width). Returns (Prepared, IoU of its silhouette with the truth)."""
+    import dataclasses
+
+    from radar_cli.derender.inputs import located_input, white_backdrop, whole_photo
+
+    if kind == "whole_frame":
+        rgb = variant.image[..., :3]
+        box = whole_photo(rgb)
+        frame = crops.cut(np.ones(rgb.shape[:2], np.float32), box, size, fill=0) > 0.5
+        from radar_cli.derender.inputs import Prepared
+
+        prepared = Prepared(crops.cut(rgb, box, size), box, rgb.shape[1::-1], silhouette=frame,
+                            cut_edges=("top", "bottom", "left", "right"), frame_coverage=1.0)
+    else:
+        prepared = located_input(variant.image, size, "shifted")
+        cols = np.nonzero(prepared.silhouette.any(0))[0]
+        moved = np.roll(prepared.silhouette, max(1, (cols.max() - cols.min()) // 5), axis=1)
+        prepared = dataclasses.replace(prepared, silhouette=moved, image=white_backdrop(prepared.image, moved))
+    truth = crops.cut(variant.truth.astype(np.float32), prepared.crop, size, fill=0) > 0.5
+    return prepared, iou(prepared.silhouette, truth)
+
+
+def add_spoilt(results: Results, items: list[tuple[str, Variant]], size: int) -> dict:
+    """Append a `BROKEN` item per `tight` variant; returns their prepared inputs by row index."""
+    spoilt = {}
+    for name, variant in [item for item in items if item[1].kind == "tight"]:
+        for kind in BROKEN:
+            prepared, score = spoilt_input(kind, variant, size)
+            results.add(kind=kind, source=name, iou=score)
+            items.append((name, Variant(kind, variant.image, variant.truth)))
+            spoilt[len(items) - 1] = prepared
+    return spoilt
+
+
 def judge_status(results: Results, items: list[tuple[str, Variant]], batch: int = 16) -> None:
-    """De-render every item as `radar derender` does (bundled model) and record its quality status."""
+    """De-render every item as `radar derender` does (bundled model) and record its quality status; spoilt
+    silhouettes (`BROKEN`) are added and judged as well."""
     from radar_cli.derender.inputs import located_input
     from radar_cli.derender.predictor import Predictor
     from radar_cli.derender.quality import assess
@@ -114,12 +155,13 @@ def judge_status(results: Results, items: list[tuple[str, Variant]], batch: int 
 
     predictor = Predictor.from_checkpoint(device="cpu")
     size = predictor.setup.image_size
+    spoilt = add_spoilt(results, items, size)
     for start in range(0, len(items), batch):
         chunk = list(range(start, min(start + batch, len(items))))
         prepared = {}
         for i in chunk:
             try:
-                prepared[i] = located_input(items[i][1].image, size, items[i][0])
+                prepared[i] = spoilt.get(i) or located_input(items[i][1].image, size, items[i][0])
             except InputError:
                 results.rows[i].update(status="failed", reasons=["no object located"])
         keys = sorted(prepared)
@@ -134,9 +176,9 @@ def judge_status(results: Results, items: list[tuple[str, Variant]], batch: int 
 
 def iou_table(results: Results) -> str:
     """Markdown: mean / min located-silhouette IoU per variant kind (handles: the core against the
-    handle-free truth)."""
+    handle-free truth; `BROKEN`: the spoilt silhouettes, at the model's size)."""
     lines = ["| variant | n | mean IoU | min IoU | IoU >= 0.9 |", "|---|---|---|---|---|"]
-    for kind in (*KINDS, "handles"):
+    for kind in (*KINDS, "handles", *BROKEN):
         s = np.array([r["iou"] for r in results.rows if r["kind"] == kind])
         if len(s):
             lines.append(f"| {kind} | {len(s)} | {s.mean():.3f} | {s.min():.3f} | {(s >= 0.9).mean():.0%} |")
@@ -203,6 +245,7 @@ def main() -> None:
     if not args.no_status:
         judge_status(results, items)
         print(status_table(results))
+        print(iou_table(Results([r for r in results.rows if r["kind"] in BROKEN])))
         for r in results.rows:
             if r["iou"] < 0.8 and r.get("status") == "ok" or r["iou"] > 0.95 and r.get("status") != "ok":
                 print(f"  {r['kind']:8s} {r['source']:28s} IoU {r['iou']:.3f} {r.get('status')}: "

@@ -18,10 +18,11 @@ from radar_cli.masks.pipeline import Refined, Settings, check_photo, refine_dete
 from radar_cli.masks.refine import main_component
 
 CUTOUT_MIN_CLEAR = 0.01  # an alpha channel with at least this share of clear pixels is a cut-out's silhouette
-STAND_MIN, STAND_MAX = 0.03, 0.45  # a stand's height as a fraction of the located height
+STAND_MIN, STAND_MAX = 0.03, 0.6  # a stand's height as a fraction of the located height
 STAND_STEP = 0.08  # ... whose width differs from the vessel's foot above it by at least this fraction
 STAND_TOLERANCE = 0.015  # straight sides: the stand's edges move less than this fraction of the window per row
-STAND_COLOUR_STEP = 30.0  # ... and whose mean colour is this far (RGB levels) from the vessel's above it
+STAND_COLOUR_STEP = 30.0  # ... and whose mean colour is this far (RGB levels) from the vessel's above it ...
+STAND_BIG_STEP = 0.25  # ... unless the width step is this large
 
 
 @dataclass(frozen=True)
@@ -97,8 +98,9 @@ def _extents(mask: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
 def remove_stand(mask: np.ndarray, image: np.ndarray) -> tuple[np.ndarray, bool]:
     """Cut a stand off the bottom of a located object: the bottom rows with straight sides, a few percent to
-    under half the object's height, clearly wider or narrower than the vessel's foot above them and of another
-    colour (a vessel's own foot ring is of its glaze; a straight vessel cut by the frame has no step).
+    under two thirds of the object's height, clearly wider or narrower than the vessel's foot above them and of
+    another colour unless the step is large (a vessel's own foot ring is of its glaze; a straight vessel cut by
+    the frame has no step).
 
     Args:
         mask: n x n bool located object. image: n x n x 3 uint8, the pixels it was located in.
@@ -119,16 +121,17 @@ def remove_stand(mask: np.ndarray, image: np.ndarray) -> tuple[np.ndarray, bool]
     while k > 0 and abs(left[k - 1] - left[-1]) <= tol and abs(right[k - 1] - right[-1]) <= tol:
         k -= 1
     span = len(rows) - k
-    if not (STAND_MIN * height <= span <= STAND_MAX * height) or k < span:
+    if not (STAND_MIN * height <= span <= STAND_MAX * height) or k < 4:
         return mask, False
     stand_w = right[-1] - left[-1] + 1
     foot_w = float(np.mean(right[k - 4 : k] - left[k - 4 : k] + 1))
     stand, above = mask.copy(), mask.copy()
     stand[: rows[k]] = False
-    above[: rows[k - span]] = False
+    above[: rows[max(0, k - span)]] = False
     above[rows[k]:] = False
     colour_step = np.linalg.norm(image[stand].mean(0) - image[above].mean(0))
-    if abs(foot_w - stand_w) < STAND_STEP * stand_w or colour_step < STAND_COLOUR_STEP:
+    step = abs(foot_w - stand_w) / stand_w
+    if step < STAND_STEP or (colour_step < STAND_COLOUR_STEP and step < STAND_BIG_STEP):
         return mask, False
     return main_component(mask & ~stand), True
 

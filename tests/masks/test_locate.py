@@ -61,12 +61,16 @@ def test_stand_is_cut_off() -> None:
     mask = np.zeros((100, 100), bool)
     yy, xx = np.mgrid[0:100, 0:100]
     mask |= ((xx - 50) / 20.0) ** 2 + ((yy - 45) / 30.0) ** 2 < 1  # the vessel, rows 15..75
-    mask[74:] |= (xx[74:] > 25) & (xx[74:] < 75)  # a plinth to the bottom edge, wider than the foot
+    mask[66:76, 35:65] = True  # its foot ring, 30 px wide
+    mask[76:, 33:67] = True  # a plinth to the bottom edge, a little wider than the foot (13 %)
     image = np.full((100, 100, 3), 60, np.uint8)
-    image[74:] = 200
+    image[76:] = 200
     cut, removed = remove_stand(mask, image)
-    assert removed and not cut[80:].any() and cut[40].sum() == mask[40].sum()
-    assert not remove_stand(mask, np.full_like(image, 60))[1]  # the vessel's own colour: a foot, kept
+    assert removed and not cut[80:].any() and cut[40].sum() == mask[40].sum() and cut[70].any()
+    assert not remove_stand(mask, np.full_like(image, 60))[1]  # the vessel's own colour and a small step: kept
+    wide = mask.copy()
+    wide[76:, 20:80] = True  # a much wider plinth goes whatever its colour
+    assert remove_stand(wide, np.full_like(image, 60))[1]
     cylinder = np.zeros_like(mask)
     cylinder[20:, 35:65] = True  # a straight-sided vessel cut by the frame is not a stand
     assert not remove_stand(cylinder, image)[1]
