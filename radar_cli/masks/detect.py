@@ -26,6 +26,7 @@ MIN_REL_AREA = 0.2  # ... and components smaller than this fraction of the large
 GROUP_GAP = 0.03  # components whose boxes come this close (fraction of the long edge) are one object ...
 GROUP_OVERLAP = 0.5  # ... if they also share this fraction of the narrower one's width (a label beside it: not)
 COARSE_ITERATIONS = 4  # GrabCut iterations of the whole-photo pass
+TRIMMED = 0.75  # a first cut keeping less than this share of the evidence's object calls for a second model
 RING = 0.03  # the second backdrop model leaves out this much (fraction of the long edge) around the object
 SEED_SHARE = 0.5  # the backdrop's colour surface is refitted to this best-fitting share of the border band ...
 SEED_ROUNDS = 3  # ... this many times
@@ -198,29 +199,35 @@ def foreground_evidence(image: np.ndarray, band: np.ndarray | None = None) -> np
 
 
 def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float) -> np.ndarray:
-    """H x W bool object pixels of a detection-scale photo: GrabCut over the whole image, started from the
-    evidence (above `threshold`, holes filled: probable object; a thin ring around it: probable backdrop;
-    beyond it and `backdrop_seeds` in the border band: sure backdrop). Falls back to the thresholded evidence if GrabCut cannot run or
-    breaks the object up.
+    """H x W bool object pixels of a detection-scale photo: GrabCut over the whole image (at half its side:
+    the outline is refined at crop resolution later), started from the evidence (above `threshold`, holes
+    filled: probable object; a thin ring around it: probable backdrop; beyond it and `backdrop_seeds` in the
+    border band: sure backdrop). Falls back to the thresholded evidence if GrabCut cannot run or breaks the
+    object up.
 
     Args:
         image: H x W x 3 uint8 RGB. evidence: H x W in [0, 1] (`foreground_evidence`).
     """
     raw = evidence > threshold
+    if not raw.any():
+        return raw
     seed = _clean(raw)  # holes filled: a flat object seen only by its outline is object inside
     reach = cv2.dilate(seed.astype(np.uint8), np.ones((5, 5), np.uint8)) > 0
     tri = np.full(raw.shape, cv2.GC_BGD, np.uint8)  # GrabCut trims what the evidence took, it never adds
     tri[reach] = cv2.GC_PR_BGD
     tri[seed] = cv2.GC_PR_FGD
     tri[backdrop_seeds(image)] = cv2.GC_BGD
-    if not raw.any():
-        return raw
+    h, w = raw.shape
+    half = (max(1, w // 2), max(1, h // 2))
+    small = cv2.resize(image, half, interpolation=cv2.INTER_AREA)
+    tri = cv2.resize(tri, half, interpolation=cv2.INTER_NEAREST)
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
     try:
-        cv2.grabCut(np.ascontiguousarray(image), tri, None, bgd, fgd, COARSE_ITERATIONS, cv2.GC_INIT_WITH_MASK)
+        cv2.grabCut(np.ascontiguousarray(small), tri, None, bgd, fgd, COARSE_ITERATIONS, cv2.GC_INIT_WITH_MASK)
     except cv2.error:
         return raw
-    cut = (tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)
+    cut = ((tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)).astype(np.float32)
+    cut = cv2.resize(cut, (w, h), interpolation=cv2.INTER_LINEAR) > 0.5
     # GrabCut trims backdrop that the evidence took for object; if it breaks a modest object up instead (a flat
     # object seen only by its outline), the evidence stands
     broken = _largest_area(_clean(cut)) < 0.5 * _largest_area(seed) and seed.mean() < 0.5
@@ -240,11 +247,14 @@ def backdrop_seeds(image: np.ndarray) -> np.ndarray:
     ys, xs = np.nonzero(band)
     a = _design(xs / max(w - 1, 1) * 2 - 1.0, ys / max(h - 1, 1) * 2 - 1.0).astype(np.float64)  # N x 6
     values = image[ys, xs].astype(np.float64)  # N x 3
-    keep = np.ones(len(ys), bool)
+    sample = np.arange(0, len(ys), max(1, len(ys) // 3000))  # a few thousand pixels pin six coefficients down
+    keep = sample
     for _ in range(SEED_ROUNDS):
-        coef = np.linalg.lstsq(a[keep], values[keep], rcond=None)[0]  # 6 x 3
-        resid = np.linalg.norm(values - a @ coef, axis=1)
-        keep = resid <= np.quantile(resid, SEED_SHARE)
+        fit_a, fit_b = a[keep], values[keep]
+        coef = np.linalg.solve(fit_a.T @ fit_a + 1e-6 * np.eye(6), fit_a.T @ fit_b)  # 6 x 3 (normal equations)
+        resid = np.linalg.norm(values[sample] - a[sample] @ coef, axis=1)
+        keep = sample[resid <= np.quantile(resid, SEED_SHARE)]
+    resid = np.linalg.norm(values - a @ coef, axis=1)
     fits = resid <= max(3.0 * 1.4826 * float(np.median(resid[keep])), SEED_MIN_TOLERANCE)
     seeds = np.zeros(band.shape, bool)
     seeds[ys[fits], xs[fits]] = True
@@ -324,10 +334,14 @@ def detect(image: np.ndarray, threshold: float = 0.5) -> list[Detection]:
     small, scale = downscale(image)
     evidence = foreground_evidence(small)
     raw = coarse_grabcut(small, evidence, threshold)
-    if raw.any():  # the backdrop seen all round the object, not only at the border: vignettes, light pools
+    if raw.sum() < TRIMMED * (evidence > threshold).sum():
+        # GrabCut trimmed much of what the border model took for object: model the backdrop again from all
+        # round the object, not only the border (vignettes, light pools), and cut again
         clear = ~(cv2.dilate(_clean(raw).astype(np.uint8), _square(RING * max(raw.shape))) > 0)
         if clear.mean() > RING:
-            evidence = foreground_evidence(small, clear | border_band(raw.shape))
+            sparse = np.zeros_like(clear)
+            sparse[::3, ::3] = True  # every ninth pixel models a smooth backdrop as well as all of them
+            evidence = foreground_evidence(small, (clear & sparse) | border_band(raw.shape))
             raw = coarse_grabcut(small, evidence, threshold)
     mask = _clean(raw)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
