@@ -26,7 +26,6 @@ MIN_REL_AREA = 0.2  # ... and components smaller than this fraction of the large
 GROUP_GAP = 0.03  # components whose boxes come this close (fraction of the long edge) are one object ...
 GROUP_OVERLAP = 0.5  # ... if they also share this fraction of the narrower one's width (a label beside it: not)
 COARSE_ITERATIONS = 4  # GrabCut iterations of the whole-photo pass
-TRIMMED = 0.75  # a first cut keeping less than this share of the evidence's object calls for a second model
 RING = 0.03  # the second backdrop model leaves out this much (fraction of the long edge) around the object
 SEED_SHARE = 0.5  # the backdrop's colour surface is refitted to this best-fitting share of the border band ...
 SEED_ROUNDS = 3  # ... this many times
@@ -199,11 +198,10 @@ def foreground_evidence(image: np.ndarray, band: np.ndarray | None = None) -> np
 
 
 def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float) -> np.ndarray:
-    """H x W bool object pixels of a detection-scale photo: GrabCut over the whole image (at half its side:
-    the outline is refined at crop resolution later), started from the evidence (above `threshold`, holes
-    filled: probable object; a thin ring around it: probable backdrop; beyond it and `backdrop_seeds` in the
-    border band: sure backdrop). Falls back to the thresholded evidence if GrabCut cannot run or breaks the
-    object up.
+    """H x W bool object pixels of a detection-scale photo: GrabCut over the whole image, started from the
+    evidence (above `threshold`, holes filled: probable object; a thin ring around it: probable backdrop; beyond
+    it and `backdrop_seeds` in the border band: sure backdrop). Falls back to the thresholded evidence if
+    GrabCut cannot run or breaks the object up.
 
     Args:
         image: H x W x 3 uint8 RGB. evidence: H x W in [0, 1] (`foreground_evidence`).
@@ -217,17 +215,12 @@ def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float) ->
     tri[reach] = cv2.GC_PR_BGD
     tri[seed] = cv2.GC_PR_FGD
     tri[backdrop_seeds(image)] = cv2.GC_BGD
-    h, w = raw.shape
-    half = (max(1, w // 2), max(1, h // 2))
-    small = cv2.resize(image, half, interpolation=cv2.INTER_AREA)
-    tri = cv2.resize(tri, half, interpolation=cv2.INTER_NEAREST)
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
     try:
-        cv2.grabCut(np.ascontiguousarray(small), tri, None, bgd, fgd, COARSE_ITERATIONS, cv2.GC_INIT_WITH_MASK)
+        cv2.grabCut(np.ascontiguousarray(image), tri, None, bgd, fgd, COARSE_ITERATIONS, cv2.GC_INIT_WITH_MASK)
     except cv2.error:
         return raw
-    cut = ((tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)).astype(np.float32)
-    cut = cv2.resize(cut, (w, h), interpolation=cv2.INTER_LINEAR) > 0.5
+    cut = (tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)
     # GrabCut trims backdrop that the evidence took for object; if it breaks a modest object up instead (a flat
     # object seen only by its outline), the evidence stands
     broken = _largest_area(_clean(cut)) < 0.5 * _largest_area(seed) and seed.mean() < 0.5
@@ -321,12 +314,14 @@ def _groups(boxes: list[tuple[int, int, int, int]], gap: float) -> list[list[int
     return list(out.values())
 
 
-def detect(image: np.ndarray, threshold: float = 0.5) -> list[Detection]:
+def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) -> list[Detection]:
     """Find the objects in a studio photograph.
 
     Args:
         image: H x W x 3 uint8 RGB, any size (it is downscaled to `WORK_SIDE` here).
         threshold: evidence level that separates object from backdrop.
+        thorough: model the backdrop a second time from all round the first cut and cut again (about 1.5x
+            the time; `radar derender` locates its one object so, `radar masks` does not).
 
     Returns:
         Detections, largest first; empty if nothing stands out from the backdrop.
@@ -334,9 +329,8 @@ def detect(image: np.ndarray, threshold: float = 0.5) -> list[Detection]:
     small, scale = downscale(image)
     evidence = foreground_evidence(small)
     raw = coarse_grabcut(small, evidence, threshold)
-    if raw.sum() < TRIMMED * (evidence > threshold).sum():
-        # GrabCut trimmed much of what the border model took for object: model the backdrop again from all
-        # round the object, not only the border (vignettes, light pools), and cut again
+    if thorough and raw.any():  # model the backdrop again from all round the object, not only the border
+        # (vignettes, light pools, a stand's surroundings), and cut again
         clear = ~(cv2.dilate(_clean(raw).astype(np.uint8), _square(RING * max(raw.shape))) > 0)
         if clear.mean() > RING:
             sparse = np.zeros_like(clear)

@@ -155,7 +155,7 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
         found = alpha_detection(opaque)
         refined = alpha_refined(rgb, opaque, found, settings)
     else:
-        detections = detect(rgb)
+        detections = detect(rgb, thorough=True)
         if not detections:
             raise InputError(f"{name}: no object stands out from the backdrop; crop it square or use --crop none")
         found = detections[0]
