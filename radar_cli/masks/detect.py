@@ -333,9 +333,7 @@ def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) ->
         # (vignettes, light pools, a stand's surroundings), and cut again
         clear = ~(cv2.dilate(_clean(raw).astype(np.uint8), _square(RING * max(raw.shape))) > 0)
         if clear.mean() > RING:
-            sparse = np.zeros_like(clear)
-            sparse[::3, ::3] = True  # every ninth pixel models a smooth backdrop as well as all of them
-            evidence = foreground_evidence(small, (clear & sparse) | border_band(raw.shape))
+            evidence = foreground_evidence(small, clear | border_band(raw.shape))
             raw = coarse_grabcut(small, evidence, threshold)
     mask = _clean(raw)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
