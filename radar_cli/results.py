@@ -32,6 +32,7 @@ FAILURES_FILE = "failures.csv"
 
 # exports written by radar_cli.derender (not needed by `radar eval`)
 RECON_FILE = "recon.png"
+APPENDAGES_FILE = "appendages.png"  # the located object's pixels left out of the solid (L, 255 = appendage)
 ALBEDO_FILE = "albedo.png"  # 360 deg unwrapped albedo, tone-mapped; the meshes' texture; relight reads it
 TEXTURE_FILE = "texture.png"
 NORMAL_FILE = "normal.png"

@@ -12,10 +12,11 @@ from radar_cli.derender.inputs import InputItem, Prepared
 from radar_cli.derender.maps import write_maps, write_picture
 from radar_cli.derender.mesh import write_meshes
 from radar_cli.derender.predictor import AlbedoSource, ModelSetup, PitchSource
+from radar_cli.derender.quality import assess
 from radar_cli.derender.renders import write_renders
 from radar_cli.derender.state import ObjectState
 from radar_cli.fileio import write_json
-from radar_cli.results import INPUT_FILE, MATERIAL_FILE, SILHOUETTE_FILE
+from radar_cli.results import APPENDAGES_FILE, INPUT_FILE, MATERIAL_FILE, SILHOUETTE_FILE
 
 
 MIN_VIEW_SIZE = 128
@@ -68,6 +69,8 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
     write_picture(folder / INPUT_FILE, prepared.photo_image)
     if prepared.photo_silhouette is not None:
         write_picture(folder / SILHOUETTE_FILE, prepared.photo_silhouette.astype(np.uint8) * 255)
+    if prepared.appendages is not None:
+        write_picture(folder / APPENDAGES_FILE, prepared.appendages.astype(np.uint8) * 255)
     write_maps(folder, state, setup.render)
     write_meshes(folder, state, setup.geometry.n_cols)
     write_renders(folder, state, side, config.view_side(side), config.views, envs)
@@ -85,6 +88,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         "pitch_source": pitch_source,
         **({"refine": refine} if refine is not None else {}),
         "environments": sorted(envs),
+        "quality": assess(prepared, state),
     })
     write_json(folder / MATERIAL_FILE, record)
     return record

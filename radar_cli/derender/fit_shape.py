@@ -37,6 +37,7 @@ class ShapeFitConfig:
         roughness_weight: the profile's bending (sum of squared second differences x 1e3, at 64 rows).
         basin: the lip may pick any candidate whose outline score is within this of the best.
         lip_contrast: the lip is trusted where its contrast (grey levels 0..1) exceeds this.
+        prior_reach: without a lip, the outline's pick stays within this of the network's pitch (degrees).
         lip_tie: coarse candidates whose lip is at least this fraction of the strongest count as tied; the
             outline picks among them.
         lip_offset_px, fine_lip_offset_px: the lip's two sides are sampled this far above and below the arc (px
@@ -56,6 +57,7 @@ class ShapeFitConfig:
     basin: float = 3.0
     lip_contrast: float = 0.1
     lip_tie: float = 0.9
+    prior_reach: float = 3.0
     lip_offset_px: float = 2.0
     fine_lip_offset_px: float = 1.0
     width_rounds: int = 3
@@ -230,15 +232,21 @@ def _pick(score: torch.Tensor, contrast: torch.Tensor, config: ShapeFitConfig) -
     return int(score.argmin()), "outline"
 
 
-def search_pitch(target: Outline, grey: torch.Tensor, size: int, config: ShapeFitConfig,
-                 camera: CameraConfig) -> tuple[tuple[torch.Tensor, ...], str]:
+def search_pitch(target: Outline, grey: torch.Tensor, size: int, config: ShapeFitConfig, camera: CameraConfig,
+                 prior_pitch: float | None = None) -> tuple[tuple[torch.Tensor, ...], str]:
     """Coarse then fine pitch grids; the fine one keeps the coarse one's cue. `grey`: 1 x 2 x N x N image and
     coverage (lip_contrast). Returns ((radius, height, pose) of the chosen candidate, batch of one, float64; the
-    cue)."""
+    cue). Without a lip, the outline alone picks the pitch only within config.prior_reach of `prior_pitch` (the
+    network's) where one is given: a real rim's thickness and a foot's bevel draw arcs that the outline reads as
+    a higher pitch."""
     roll, tx = axis_from_outline(target, size, camera)
     coarse = torch.arange(0.0, config.pitch_max + 1e-6, config.coarse_step, dtype=torch.float64)
     _, score, contrast = _search(target, grey, size, coarse, roll, tx, config, camera, config.lip_offset_px)
     best, cue = _pick(score, contrast, config)
+    if cue == "outline" and prior_pitch is not None:
+        near = (coarse - prior_pitch).abs() <= config.prior_reach
+        if near.any():
+            best = int(torch.where(near, score, torch.full_like(score, math.inf)).argmin())
     centre = float(coarse[best])
     fine = torch.arange(centre - config.coarse_step, centre + config.coarse_step + 1e-6, config.fine_step,
                         dtype=torch.float64).clamp(0.0, config.pitch_max)
@@ -272,13 +280,14 @@ def polish(target: Outline, size: int, radius: torch.Tensor, height: torch.Tenso
 
 
 def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = ShapeFitConfig(),
-              camera: CameraConfig = CameraConfig()) -> ShapeFit:
+              camera: CameraConfig = CameraConfig(), prior_pitch: float | None = None) -> ShapeFit:
     """Fit shape and pose to one object's silhouette and image.
 
     Args:
         mask: N x N silhouette (bool or coverage in [0, 1]) of the crop.
         grey: N x N grey image in [0, 1] of the same crop (the lip's contrast).
         config: the fit's settings. camera: the fixed camera.
+        prior_pitch: the network's pitch (degrees), bounding an outline-only pick (search_pitch).
 
     Returns:
         ShapeFit at resolution N (polished at N, searched at min(N, config.grid_size)).
@@ -287,7 +296,7 @@ def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = Shape
     grid = min(size, config.grid_size)
     coarse_target = mask_outline(downsample(mask, grid))
     grey_t = torch.from_numpy(np.stack([np.asarray(grey, np.float32), np.asarray(mask, np.float32)]))[None]
-    (radius, height, pose), cue = search_pitch(coarse_target, grey_t, grid, config, camera)
+    (radius, height, pose), cue = search_pitch(coarse_target, grey_t, grid, config, camera, prior_pitch)
     target = mask_outline(np.asarray(mask, np.float64))
     radius = correct_widths(target, size, radius, height, pose, config.width_rounds, camera)
     for level, steps in zip((grid, size), config.polish_steps):

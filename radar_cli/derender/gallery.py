@@ -22,8 +22,8 @@ import numpy as np
 from radar_cli.derender.environments import builtin_environments
 from radar_cli.errors import RadarError
 from radar_cli.fileio import atomic_path, read_image, write_image, write_text
-from radar_cli.results import (ENV_MAP_FILE, INDEX_FILE, INPUT_FILE, MATERIAL_FILE, RECON_FILE, RELIT_PREFIX,
-                               SUMMARY_FILE)
+from radar_cli.results import (APPENDAGES_FILE, ENV_MAP_FILE, INDEX_FILE, INPUT_FILE, MATERIAL_FILE, RECON_FILE,
+                               RELIT_PREFIX, SUMMARY_FILE)
 
 ASSETS = Path(__file__).resolve().parents[1] / "assets" / "gallery"
 GALLERY_DIR = ".gallery"  # RESULTS/.gallery/: page code, viewer, data, built-in environments
@@ -32,7 +32,6 @@ ENV_DIR = "env"
 ENV_SCRIPT = "env.js"  # the built-in environments' .hdr files as base64, for a page opened from disk
 THUMBNAIL_FILE = "thumbnail.png"  # per object: input | reconstruction, THUMB_SIDE px each
 VIEWER_ENV_FILE = "env_viewer.hdr"  # per object: its recovered lighting in the viewer's convention
-APPENDAGES_FILE = "appendages.png"  # per object, written by the quality checks when present
 THUMB_SIDE = 128
 VIEWER_ENV_SIZE = (64, 128)  # He x We of the built-in environments written for the viewer
 VIEWER_ENV_UPSAMPLE = 4  # an object's He x We map is enlarged (nearest) so its width divides by 4

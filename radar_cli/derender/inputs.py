@@ -80,10 +80,14 @@ class Prepared:
         crop: the square window of the original photo the crop shows (x0, y0, side in its pixels).
         photo_size: (width, height) of the original photo after EXIF orientation.
         backdrop: `white` if the backdrop was replaced by white, else `kept`.
-        silhouette: S x S bool object mask of the crop, when known (located, --masks or the dataset's mask.png).
+        silhouette: S x S bool object mask of the crop, when known (located, --masks or the dataset's mask.png):
+            the symmetric core of a located or --masks silhouette (handles, spouts, knobs left out).
         photo_image: N x N x 3 uint8, the same window of the photo at the output side N (output_side; the
             backdrop treated as `image`'s); `image` itself when N = S (the default).
         photo_silhouette: N x N bool, `silhouette` at N (None where that is None).
+        appendages: N x N bool, the located object's pixels left out of the core; None if not split.
+        cut_edges: the photo edges the located object runs into (`top`, `bottom`, `left`, `right`).
+        frame_coverage: share of the photo the located object covers; None if not located.
     """
 
     image: np.ndarray
@@ -93,6 +97,9 @@ class Prepared:
     silhouette: np.ndarray | None = None
     photo_image: np.ndarray | None = None
     photo_silhouette: np.ndarray | None = None
+    appendages: np.ndarray | None = None
+    cut_edges: tuple[str, ...] = ()
+    frame_coverage: float | None = None
 
     def __post_init__(self) -> None:
         if self.photo_image is None:  # frozen: the network's crop is the output crop
@@ -200,56 +207,24 @@ def _unique(found: list[InputItem], failures: list[Failure]) -> list[InputItem]:
     return items
 
 
-@dataclass(frozen=True)
-class Located:
-    """An object found in a photo: its window, and the crop and silhouette at the network's side S and at the
-    output side N (the same arrays when N = S)."""
-
-    box: CropBox
-    image: np.ndarray
-    silhouette: np.ndarray
-    photo_image: np.ndarray
-    photo_silhouette: np.ndarray
-
-
 def resize_mask(mask: np.ndarray, side: int) -> np.ndarray:
     """An H x H bool mask at side x side: its coverage resampled (area down, bilinear up) and cut at 0.5."""
     import cv2
 
+    if mask.shape[0] == side:
+        return mask
     interp = cv2.INTER_AREA if mask.shape[0] > side else cv2.INTER_LINEAR
     return cv2.resize(mask.astype(np.float32), (side, side), interpolation=interp) > 0.5
 
 
-def locate(photo: np.ndarray, size: int, name: str, resolution: Resolution = DEFAULT_RESOLUTION) -> Located:
-    """The object's square crop, cut exactly as `radar masks` cuts its training crops (detect, GrabCut, frame).
+def resize_image(image: np.ndarray, side: int) -> np.ndarray:
+    """An H x H x 3 uint8 image at side x side (area down, bilinear up)."""
+    import cv2
 
-    The silhouette is refined at the larger of S and the output side (GrabCut itself runs at most at 192 px;
-    its edges are snapped at that side), and resampled to the other.
-
-    Args:
-        photo: H x W x 3 uint8.
-        size: S, the network's crop side.
-        name: the file, for messages.
-        resolution: the requested output side (see output_side).
-
-    Returns:
-        Located: S x S and N x N crops and bool silhouettes, and the window in the photo.
-    """
-    from radar_cli.masks.detect import detect
-    from radar_cli.masks.pipeline import Settings, check_photo, crop_detection
-
-    check_photo(photo, name)
-    found = detect(photo)
-    if not found:
-        raise InputError(f"{name}: no object stands out from the backdrop; crop it square or use --crop none")
-    work = max(size, output_side(resolution, square_box(found[0].box).side))
-    crop = crop_detection(photo, found[0], Settings(size=work))
-    side = output_side(resolution, crop.box.side)
-
-    def at(n: int) -> tuple[np.ndarray, np.ndarray]:
-        return (crop.image, crop.mask) if n == work else (cut(photo, crop.box, n), resize_mask(crop.mask, n))
-
-    return Located(crop.box, *at(size), *at(side))
+    if image.shape[0] == side:
+        return image
+    interp = cv2.INTER_AREA if image.shape[0] > side else cv2.INTER_LINEAR
+    return cv2.resize(image, (side, side), interpolation=interp)
 
 
 def whole_photo(photo: np.ndarray) -> CropBox:
@@ -279,12 +254,21 @@ def _known_mask(item: InputItem, shape: tuple[int, int]) -> np.ndarray | None:
     return mask
 
 
+def _split(silhouette: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A known bool silhouette's symmetric core and appendages."""
+    from radar_cli.masks.appendages import symmetric_core
+
+    parts = symmetric_core(silhouette)
+    return parts.core, parts.appendages
+
+
 def prepare(item: InputItem, size: int, crop: CropMode = "auto", backdrop: Backdrop = "white",
             resolution: Resolution = DEFAULT_RESOLUTION) -> Prepared:
     """Read a photo and cut the network's input and the output-resolution crop.
 
-    `auto` locates the object and crops around it (from the --masks silhouette if given, else as `radar masks`
-    does); `none` pads the whole photo to a square. Dataset samples are crops already and are used whole.
+    `auto` locates the object in any framing and crops around its symmetric core (masks.locate; from the
+    --masks silhouette if given); `none` pads the whole photo to a square. Dataset samples are crops already and
+    are used whole, with their mask as it is. A transparent cut-out's alpha channel is its silhouette.
 
     Args:
         item: the input.
@@ -297,24 +281,52 @@ def prepare(item: InputItem, size: int, crop: CropMode = "auto", backdrop: Backd
     Returns:
         Prepared; InputError names the file on any problem.
     """
-    photo = read_image(item.image_path, "RGB")
+    from radar_cli.masks.locate import split_alpha
+
+    photo = read_image(item.image_path, "RGBA")
     h, w = photo.shape[:2]
     mask = _known_mask(item, (h, w))
     if mask is None and not item.is_crop and crop == "auto":
-        found = locate(photo, size, str(item.image_path), resolution)
-        box, image, silhouette = found.box, found.image, found.silhouette
-        photo_image, photo_silhouette = found.photo_image, found.photo_silhouette
-    else:
-        box = whole_photo(photo) if item.is_crop or crop == "none" else square_box(mask_box(mask))  # type: ignore
-        side = output_side(resolution, box.side)
-        mask8 = None if mask is None else mask.astype(np.uint8) * 255
-        image = cut(photo, box, size)
-        silhouette = None if mask8 is None else cut(mask8, box, size) > 127
-        photo_image = image if side == size else cut(photo, box, side)
-        photo_silhouette = silhouette if side == size or mask8 is None else cut(mask8, box, side) > 127
-    if backdrop == "white" and silhouette is not None:
-        white = white_backdrop(image, silhouette)
-        photo_white = white if photo_image is image else white_backdrop(photo_image, photo_silhouette)
-        return Prepared(white, box, (w, h), "white", silhouette, photo_white, photo_silhouette)
-    return Prepared(np.ascontiguousarray(image), box, (w, h), silhouette=silhouette,
-                    photo_image=np.ascontiguousarray(photo_image), photo_silhouette=photo_silhouette)
+        return located_input(photo, size, str(item.image_path), backdrop, resolution)
+    rgb, _ = split_alpha(photo)
+    box = whole_photo(rgb) if item.is_crop or crop == "none" else square_box(mask_box(mask))  # type: ignore
+    side = output_side(resolution, box.side)
+    image = cut(rgb, box, size)
+    photo_image = image if side == size else cut(rgb, box, side)
+    photo_silhouette = None if mask is None else cut(mask.astype(np.uint8) * 255, box, side) > 127
+    appendages = None
+    if photo_silhouette is not None and not item.is_crop:
+        photo_silhouette, appendages = _split(photo_silhouette)
+    silhouette = None if photo_silhouette is None else resize_mask(photo_silhouette, size)
+    return _on_backdrop(Prepared(np.ascontiguousarray(image), box, (w, h), silhouette=silhouette,
+                                 photo_image=np.ascontiguousarray(photo_image), photo_silhouette=photo_silhouette,
+                                 appendages=appendages), backdrop)
+
+
+def located_input(photo: np.ndarray, size: int, name: str, backdrop: Backdrop = "white",
+                  resolution: Resolution = DEFAULT_RESOLUTION) -> Prepared:
+    """The network's input and the output-side crop of a photo (H x W x 3 RGB or x 4 RGBA) whose object is
+    located (masks.locate), located at the larger of the two sides and resampled to the other."""
+    from radar_cli.masks.locate import locate_object
+
+    work = max(size, MAX_RESOLUTION if resolution == "photo" else int(resolution))
+    found = locate_object(photo, work, name)
+    side = output_side(resolution, found.box.side)
+    h, w = photo.shape[:2]
+    located = Prepared(resize_image(found.image, size), found.box, (w, h),
+                       silhouette=resize_mask(found.silhouette, size),
+                       photo_image=resize_image(found.image, side), photo_silhouette=resize_mask(found.silhouette, side),
+                       appendages=resize_mask(found.appendages, side), cut_edges=found.cut_edges,
+                       frame_coverage=round(found.frame_coverage, 4))
+    return _on_backdrop(located, backdrop)
+
+
+def _on_backdrop(prepared: Prepared, backdrop: Backdrop) -> Prepared:
+    """`white`: the object put on white through its silhouette, at both sides (appendages whited out with the
+    backdrop)."""
+    if backdrop == "white" and prepared.silhouette is not None:
+        white = white_backdrop(prepared.image, prepared.silhouette)
+        photo = white if prepared.photo_image is prepared.image else white_backdrop(prepared.photo_image,
+                                                                                     prepared.photo_silhouette)
+        return dataclasses.replace(prepared, image=white, photo_image=photo, backdrop="white")
+    return prepared

@@ -92,7 +92,7 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
                                      absolute=True)[0])
     grey = crop.astype(np.float32).mean(axis=2) / 255.0
     try:
-        fit = fit_shape(silhouette, grey, config, camera)
+        fit = fit_shape(silhouette, grey, config, camera, float(dec.pose[0, 0]))
         refined_iou = silhouette_iou(fit.radius, fit.height, fit.pose, silhouette, camera)
     except FIT_ERRORS as e:
         return None, RefineReport("fallback", f"the fit failed ({type(e).__name__}: {e})", size,

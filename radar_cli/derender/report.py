@@ -13,8 +13,11 @@ from radar_cli.derender.inputs import Failure
 from radar_cli.fileio import write_text
 from radar_cli.results import FAILURES_FILE, MATERIAL_FILE, SUMMARY_FILE, list_results
 
-SUMMARY_COLUMNS = ("object", "source", "pitch", "roll", "tx", "ty", "height", "alpha", "rho", "roughness",
-                   "crop_box", "model", "resolution", "refine", "refine_reason", "refine_iou")
+SUMMARY_COLUMNS = ("object", "status", "reason", "source", "pitch", "roll", "tx", "ty", "height", "alpha", "rho",
+                   "roughness", "crop_box", "model", "silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction",
+                   "cut_edges", "resolution", "refine", "refine_reason", "refine_iou")
+QUALITY_COLUMNS = ("silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction")
+STATUS_ORDER = {"failed": 0, "review": 1, "ok": 2}  # worst first; objects without a quality record come last
 
 
 def read_records(root: Path) -> list[tuple[str, dict]]:
@@ -28,8 +31,19 @@ def read_records(root: Path) -> list[tuple[str, dict]]:
     return records
 
 
+def by_status(records: list[tuple[str, dict]]) -> list[tuple[str, dict]]:
+    """The records with `failed` first, then `review`, then `ok` (by name within each)."""
+    def rank(item: tuple[str, dict]) -> tuple[int, str]:
+        quality = item[1].get("quality")
+        status = quality.get("status") if isinstance(quality, dict) else None
+        return STATUS_ORDER.get(status, len(STATUS_ORDER)), item[0]
+
+    return sorted(records, key=rank)
+
+
 def write_summary(root: Path, records: list[tuple[str, dict]]) -> None:
-    """summary.csv: one row per object with its pose, shape and material, and what the refinement did."""
+    """summary.csv: one row per object with its status and quality scores, pose, shape and material, and what
+    the refinement did."""
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=SUMMARY_COLUMNS, extrasaction="ignore")
     writer.writeheader()
@@ -41,9 +55,14 @@ def write_summary(root: Path, records: list[tuple[str, dict]]) -> None:
         row["refine"], row["refine_reason"] = refine.get("status", ""), refine.get("reason", "")
         iou = (refine.get("silhouette_iou") or {}).get("refined")
         row["refine_iou"] = "" if iou is None else f"{iou:.4f}"
-        for k in ("pitch", "roll", "tx", "ty", "height", "alpha", "rho", "roughness"):
+        quality = rec.get("quality") if isinstance(rec.get("quality"), dict) else {}
+        row.update({k: quality.get(k) for k in QUALITY_COLUMNS}, status=quality.get("status", ""),
+                   reason="; ".join(quality.get("reasons", [])), cut_edges=" ".join(quality.get("cut_edges", [])))
+        for k in ("pitch", "roll", "tx", "ty", "height", "alpha", "rho", "roughness") + QUALITY_COLUMNS:
             if isinstance(row[k], float):
                 row[k] = f"{row[k]:.4g}"
+            elif row[k] is None:
+                row[k] = ""
         writer.writerow(row)
     write_text(root / SUMMARY_FILE, buf.getvalue())
 
@@ -61,7 +80,7 @@ def write_failures(root: Path, failures: list[Failure]) -> None:
 def write_report(root: str | Path, failures: list[Failure]) -> Path:
     """Write summary.csv, failures.csv and index.html for every complete object under `root`."""
     root = Path(root)
-    records = read_records(root)
+    records = by_status(read_records(root))
     write_summary(root, records)
     write_failures(root, failures)
     return write_gallery(root, records, len(failures))

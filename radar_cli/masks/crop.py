@@ -44,8 +44,9 @@ def square_box(box: tuple[float, float, float, float], margin: float = DEFAULT_M
     return CropBox(int(round(cx - side / 2.0)), int(round(cy - side / 2.0)), side)
 
 
-def cut(image: np.ndarray, crop: CropBox, size: int) -> np.ndarray:
-    """The crop of an H x W (x C) image, resized to size x size; outside the photo the edge is replicated.
+def cut(image: np.ndarray, crop: CropBox, size: int, fill: float | None = None) -> np.ndarray:
+    """The crop of an H x W (x C) image, resized to size x size; outside the photo the edge is replicated, or
+    filled with the value `fill` if given.
 
     Returns:
         size x size (x C), same dtype.
@@ -55,9 +56,32 @@ def cut(image: np.ndarray, crop: CropBox, size: int) -> np.ndarray:
     pad = (max(0, -y0), max(0, y1 - h), max(0, -x0), max(0, x1 - w))
     window = image[max(0, y0) : min(h, y1), max(0, x0) : min(w, x1)]
     if any(pad):
-        window = cv2.copyMakeBorder(window, *pad, borderType=cv2.BORDER_REPLICATE)
+        window = (cv2.copyMakeBorder(window, *pad, borderType=cv2.BORDER_REPLICATE) if fill is None else
+                  cv2.copyMakeBorder(window, *pad, borderType=cv2.BORDER_CONSTANT, value=[fill] * 4))
     interp = cv2.INTER_AREA if crop.side > size else cv2.INTER_LINEAR
     return cv2.resize(window, (size, size), interpolation=interp)
+
+
+def outside_mask(crop: CropBox, image_shape: tuple[int, ...], size: int) -> np.ndarray:
+    """size x size bool: True on the crop's padding (beyond the photo's edge), False on real photo pixels."""
+    u0, v0, u1, v1 = valid_region(crop, image_shape, size)
+    out = np.ones((size, size), bool)
+    out[v0:v1, u0:u1] = False
+    return out
+
+
+def cut_edges(mask: np.ndarray, region: tuple[int, int, int, int], min_run: float = 0.02) -> tuple[str, ...]:
+    """The photo edges (`top`, `bottom`, `left`, `right`) that cut the object: where the bool crop mask runs
+    along the edge of `region` (u0, v0, u1, v1: the crop's real photo pixels) for at least `min_run` of the
+    crop's side. A crop framed around the whole object never reaches its own edges, so an edge of the region
+    that the object touches is the photo's."""
+    u0, v0, u1, v1 = region
+    if u1 - u0 < 2 or v1 - v0 < 2:
+        return ()
+    inner = mask[v0:v1, u0:u1]
+    need = max(1, int(min_run * mask.shape[0]))
+    lines = {"top": inner[0], "bottom": inner[-1], "left": inner[:, 0], "right": inner[:, -1]}
+    return tuple(name for name, line in lines.items() if int(line.sum()) >= need)
 
 
 def crop_affine(crop: CropBox, size: int, scale: float = 1.0) -> np.ndarray:

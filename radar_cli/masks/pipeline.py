@@ -94,6 +94,69 @@ def check_photo(image: np.ndarray, name: str) -> None:
         raise InputError(f"{name}: image is a flat colour, nothing to segment")
 
 
+@dataclass(frozen=True)
+class Refined:
+    """One detection refined at crop resolution.
+
+    Attributes:
+        mask: n x n bool object mask of `window` (n = its work side).
+        window: the square window of the photo it covers (may reach beyond the photo's edge).
+        outside: n x n bool, the window's padding beyond the photo's edge.
+        grabcut: whether GrabCut's answer was kept.
+        image: n x n x 3 uint8, the window's pixels.
+    """
+
+    mask: np.ndarray
+    window: crops.CropBox
+    outside: np.ndarray
+    grabcut: bool
+    image: np.ndarray
+    def framed(self, image: np.ndarray, mask: np.ndarray, settings: Settings, box_mask: np.ndarray | None = None,
+               fill: float | None = None) -> tuple[crops.CropBox, np.ndarray, np.ndarray]:
+        """The final square crop around `box_mask` (default `mask`; n x n bool in this window): (its box in the
+        photo, size x size x 3 uint8 image padded as `crops.cut` with `fill`, `mask` cut to size x size bool)."""
+        n = self.mask.shape[0]
+        box = crops.mask_box(mask if box_mask is None else box_mask) or (0, 0, n, n)
+        k = self.window.side / n  # photo pixels per work pixel
+        w = self.window
+        final = crops.square_box((w.x0 + box[0] * k, w.y0 + box[1] * k, w.x0 + box[2] * k, w.y0 + box[3] * k),
+                                 settings.margin)
+        to_final = crops.crop_affine(final, settings.size, 1.0 / k) @ np.vstack(
+            [[1, 0, w.x0 / k], [0, 1, w.y0 / k], [0, 0, 1]])
+        return final, crops.cut(image, final, settings.size, fill), crops.warp_mask(mask, to_final, settings.size)
+
+
+def refine_window(found: Detection, settings: Settings) -> tuple[crops.CropBox, int]:
+    """The square window of the photo a detection is refined in, and its side in work pixels."""
+    fill_margin = 0.5 - (1.0 - 2.0 * settings.margin) / (2.0 * REFINE_PAD)
+    return crops.square_box(found.box, fill_margin), int(round(settings.size * REFINE_PAD))
+
+
+def refine_detection(image: np.ndarray, found: Detection, settings: Settings) -> Refined:
+    """GrabCut one detection in a window a little larger than its final crop. The window's padding beyond the
+    photo's edge is painted in the backdrop's colour and is never object, so a vessel cut by the frame ends at
+    the frame.
+
+    Args:
+        image: H x W x 3 uint8 (the decoded photo the detection's box refers to).
+        found: a detection in that photo.
+        settings: sizes.
+    """
+    window, work_side = refine_window(found, settings)
+    work_img = crops.cut(image, window, work_side)
+    outside = crops.outside_mask(window, image.shape, work_side)
+    to_work = crops.crop_affine(window, work_side, found.scale)
+    rough = crops.warp_mask(found.mask, to_work, work_side)
+    sure = None if found.sure is None else crops.warp_mask(found.sure, to_work, work_side)
+    backdrop = ~rough & ~outside
+    if outside.any() and backdrop.any():
+        work_img[outside] = np.median(work_img[backdrop], axis=0).astype(np.uint8)
+    mask, used_grabcut = refine(work_img, rough, sure=sure, outside=outside)
+    if not mask.any():
+        mask = rough & ~outside if (rough & ~outside).any() else ~outside
+    return Refined(mask, window, outside, used_grabcut, work_img)
+
+
 def crop_detection(image: np.ndarray, found: Detection, settings: Settings) -> Crop:
     """Refine one detection at crop resolution and cut the final, scored crop.
 
@@ -102,26 +165,10 @@ def crop_detection(image: np.ndarray, found: Detection, settings: Settings) -> C
         found: a detection in that photo.
         settings: sizes and thresholds.
     """
-    work_side = int(round(settings.size * REFINE_PAD))
-    fill_margin = 0.5 - (1.0 - 2.0 * settings.margin) / (2.0 * REFINE_PAD)
-    window = crops.square_box(found.box, fill_margin)
-    work_img = crops.cut(image, window, work_side)
-    to_work = crops.crop_affine(window, work_side, found.scale)
-    rough = crops.warp_mask(found.mask, to_work, work_side)
-    sure = None if found.sure is None else crops.warp_mask(found.sure, to_work, work_side)
-    mask, used_grabcut = refine(work_img, rough, sure=sure)
-    box = crops.mask_box(mask)
-    if box is None:
-        box, mask = crops.mask_box(rough) or (0, 0, work_side, work_side), rough
-    k = window.side / work_side  # photo pixels per work pixel
-    photo_box = (window.x0 + box[0] * k, window.y0 + box[1] * k, window.x0 + box[2] * k, window.y0 + box[3] * k)
-    final = crops.square_box(photo_box, settings.margin)
-    out_img = crops.cut(image, final, settings.size)
-    to_final = crops.crop_affine(final, settings.size, 1.0 / k) @ np.vstack(
-        [[1, 0, window.x0 / k], [0, 1, window.y0 / k], [0, 0, 1]])
-    out_mask = crops.warp_mask(mask, to_final, settings.size)
+    refined = refine_detection(image, found, settings)
+    final, out_img, out_mask = refined.framed(image, refined.mask, settings)
     scores = score_mask(out_mask, crops.valid_region(final, image.shape, settings.size))
-    scores.update(detector=round(found.score, 4), grabcut=used_grabcut)
+    scores.update(detector=round(found.score, 4), grabcut=refined.grabcut)
     return Crop(out_img, out_mask, final, 1.0, scores, judge(scores, settings.limits))
 
 

@@ -25,13 +25,14 @@ def _disk(radius: int) -> np.ndarray:
     return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (d, d))
 
 
-def trimap(rough: np.ndarray, sure: np.ndarray | None = None) -> np.ndarray:
+def trimap(rough: np.ndarray, sure: np.ndarray | None = None, outside: np.ndarray | None = None) -> np.ndarray:
     """GrabCut's 4-level mask from a rough bool mask: definite foreground deep inside (and only where `sure`,
     if given), probable foreground and probable background in bands either side of the outline, definite
-    background beyond."""
+    background beyond and in `outside` (padding beyond the photo's edge)."""
     m = rough.astype(np.uint8)
     size = np.sqrt(max(int(m.sum()), 1))
-    inner = cv2.erode(m, _disk(round(INNER_BAND * size))) > 0
+    grown = m if outside is None else (rough | outside).astype(np.uint8)  # the frame's edge is no outline
+    inner = (cv2.erode(grown, _disk(round(INNER_BAND * size))) > 0) & rough
     if sure is not None:
         inner &= cv2.erode(sure.astype(np.uint8), _disk(1)) > 0
     outer = cv2.dilate(m, _disk(round(OUTER_BAND * size))) > 0
@@ -39,6 +40,8 @@ def trimap(rough: np.ndarray, sure: np.ndarray | None = None) -> np.ndarray:
     tri[outer] = cv2.GC_PR_BGD
     tri[rough] = cv2.GC_PR_FGD
     tri[inner] = cv2.GC_FGD
+    if outside is not None:
+        tri[outside] = cv2.GC_BGD
     return tri
 
 
@@ -57,10 +60,13 @@ def smooth_boundary(mask: np.ndarray, sigma: float) -> np.ndarray:
     return cv2.GaussianBlur(mask.astype(np.float32), (0, 0), sigma) > 0.5
 
 
-def clean(mask: np.ndarray, sigma: float) -> np.ndarray:
-    """Fill small holes, keep the main component, smooth the outline."""
+def clean(mask: np.ndarray, sigma: float, outside: np.ndarray | None = None) -> np.ndarray:
+    """Fill small holes, keep the main component, smooth the outline (not along `outside`, the padding beyond
+    the photo's edge: an object cut by the frame keeps its straight cut)."""
     m = main_component(fill_holes(mask, MAX_HOLE_FRAC))
-    return main_component(smooth_boundary(m, sigma))
+    if outside is None:
+        return main_component(smooth_boundary(m, sigma))
+    return main_component(smooth_boundary(m | outside, sigma) & ~outside)
 
 
 def snap_edges(image: np.ndarray, mask: np.ndarray, band: int = 2, sigma: float = 3.0) -> np.ndarray:
@@ -92,20 +98,31 @@ def snap_edges(image: np.ndarray, mask: np.ndarray, band: int = 2, sigma: float 
     return out
 
 
-def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4,
-           sure: np.ndarray | None = None) -> tuple[np.ndarray, bool]:
+def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4, sure: np.ndarray | None = None,
+           outside: np.ndarray | None = None) -> tuple[np.ndarray, bool]:
     """Refine a rough mask with GrabCut.
 
     Args:
         image: S x S x 3 uint8 RGB crop.
         rough: S x S bool rough mask (from the detector, warped into the crop).
         sure: S x S bool, where the detector saw the object itself (not a filled hole); None = everywhere.
+        outside: S x S bool, the padding beyond the photo's edge: never object (an object cut by the frame
+            ends there); None = none.
         iterations: GrabCut iterations.
 
     Returns:
         (mask S x S bool, used_grabcut): the cleaned mask; False if GrabCut failed or disagreed with the
         rough mask so much that the rough mask was kept (still cleaned).
     """
+    if outside is not None:
+        rough = rough & ~outside
+    mask, used = _refine(image, rough, iterations, sure, outside)
+    return (mask & ~outside if outside is not None else mask), used
+
+
+def _refine(image: np.ndarray, rough: np.ndarray, iterations: int, sure: np.ndarray | None,
+            outside: np.ndarray | None) -> tuple[np.ndarray, bool]:
+    """`refine` inside the photo (the caller clips the result to it)."""
     sigma = max(0.6, image.shape[0] / 256.0)
     if rough.sum() < 16:
         return clean(rough, sigma), False
@@ -115,7 +132,9 @@ def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4,
     gc_rough = cv2.resize(rough.astype(np.uint8), gc_img.shape[1::-1], interpolation=cv2.INTER_NEAREST) > 0
     gc_sure = None if sure is None else cv2.resize(sure.astype(np.uint8), gc_img.shape[1::-1],
                                                   interpolation=cv2.INTER_NEAREST) > 0
-    tri = trimap(gc_rough, gc_sure)
+    gc_outside = None if outside is None else cv2.resize(outside.astype(np.uint8), gc_img.shape[1::-1],
+                                                         interpolation=cv2.INTER_NEAREST) > 0
+    tri = trimap(gc_rough, gc_sure, gc_outside)
     if not (tri == cv2.GC_FGD).any() or not (tri == cv2.GC_BGD).any():
         return clean(rough, sigma), False
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
@@ -125,8 +144,11 @@ def refine(image: np.ndarray, rough: np.ndarray, iterations: int = 4,
         return clean(rough, sigma), False
     cut = ((tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)).astype(np.float32)
     cut = cv2.resize(cut, (side, side), interpolation=cv2.INTER_LINEAR) > 0.5
-    cut = snap_edges(image, cut, band=max(2, round(1.5 / small)))
-    refined = clean(cut, sigma)
+    if outside is None:
+        cut = snap_edges(image, cut, band=max(2, round(1.5 / small)))
+    else:
+        cut = snap_edges(image, cut | outside, band=max(2, round(1.5 / small))) & ~outside
+    refined = clean(cut, sigma, outside)
     if iou(refined, rough) < MIN_AGREEMENT:
         return clean(rough, sigma), False
     return refined, True

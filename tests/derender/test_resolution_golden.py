@@ -39,7 +39,7 @@ def _inputs(root: Path) -> Path:
 def _digests(out: Path) -> dict[str, str]:
     """{object/file: sha256} of every file of every object folder (material.json: its record, sorted)."""
     found = {}
-    for path in sorted(p for p in out.glob("*/*") if p.is_file()):
+    for path in sorted(p for p in out.glob("*/*") if p.is_file() and not p.parent.name.startswith(".")):
         data = path.read_bytes()
         if path.name == "material.json":
             record = {k: v for k, v in json.loads(data).items() if k not in RESOLUTION_KEYS}

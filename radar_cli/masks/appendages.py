@@ -1,0 +1,164 @@
+"""The symmetric core of a vessel's silhouette: the part a profile about its axis explains. Handles, spouts,
+knobs and other appendages are what is left over.
+
+Each row of a solid of revolution seen from the side is one interval centred on the projected axis. Per row,
+the core keeps the run of object pixels that holds the axis (the loop of a handle, seen beside the body, is
+another run), clipped to the shorter of its two half-widths (a spout sticks out on one side only) and to the
+row's radius after a vertical opening of the radius profile (a handle's attachment widens a few rows on both
+sides; the body's own curve is smooth over that span).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from radar_cli.masks.quality import SCORE_SIDE, TILTS_DEG, mirror_agreement, sor_score
+from radar_cli.masks.refine import main_component
+
+SIDE_TOLERANCE = 0.03  # a half-width may exceed the other by this fraction of the object's width (perspective)
+BUMP_SPAN = 0.1  # bumps of the radius profile shorter than this fraction of the height are appendages
+NEAR_AXIS = 0.05  # a row whose runs all miss the axis keeps the nearest one within this fraction of the width
+END_ROWS = 0.04  # ... unless they reach this close (fraction of the height) to the top or bottom: a rim, a foot
+MIN_APPENDAGE = 0.004  # appendage parts smaller than this fraction of the silhouette are outline noise
+
+
+@dataclass(frozen=True)
+class Core:
+    """A silhouette split into its symmetric core and its appendages.
+
+    Attributes:
+        core: H x W bool, the solid of revolution's silhouette.
+        appendages: H x W bool, the rest of the silhouette (handles, spouts, knobs).
+        tilt: the axis' tilt from vertical in degrees (positive: counter-clockwise in the image).
+        axis: the axis' x in the upright (untilted) frame, in pixels.
+        symmetry: solid-of-revolution score of the core (`quality.sor_score`), in [0, 1].
+    """
+
+    core: np.ndarray
+    appendages: np.ndarray
+    tilt: float
+    axis: float
+    symmetry: float
+
+    @property
+    def appendage_fraction(self) -> float:
+        """Share of the whole silhouette that is appendage."""
+        total = int(self.core.sum()) + int(self.appendages.sum())
+        return float(self.appendages.sum() / total) if total else 0.0
+
+
+def _rotation(mask: np.ndarray, deg: float) -> np.ndarray:
+    """2 x 3 affine rotating a mask by `deg` about its centroid."""
+    ys, xs = np.nonzero(mask)
+    return cv2.getRotationMatrix2D((float(xs.mean()), float(ys.mean())), deg, 1.0)
+
+
+def _warp(mask: np.ndarray, affine: np.ndarray) -> np.ndarray:
+    h, w = mask.shape
+    out = cv2.warpAffine(mask.astype(np.float32), affine, (w, h), flags=cv2.INTER_LINEAR)
+    return out > 0.5
+
+
+def find_axis(mask: np.ndarray) -> tuple[float, float]:
+    """The tilt (deg, over `quality.TILTS_DEG`) and x (pixels, in the mask rotated upright by that tilt about
+    its centroid) of the vertical mirror axis that best explains a bool mask."""
+    k = SCORE_SIDE / max(mask.shape)
+    small = cv2.resize(mask.astype(np.uint8), None, fx=k, fy=k, interpolation=cv2.INTER_AREA) > 0
+    best, best_tilt = -1.0, 0.0
+    for deg in TILTS_DEG:
+        score, _ = mirror_agreement(_warp(small, _rotation(small, deg)) if deg else small)
+        if score > best:
+            best, best_tilt = score, deg
+    upright = _warp(mask, _rotation(mask, best_tilt)) if best_tilt else mask
+    _, axis = mirror_agreement(upright)
+    return best_tilt, axis
+
+
+def _axis_runs(mask: np.ndarray, axis: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per row, the half-widths (left, right; NaN where none) of the run of object pixels holding the axis, or
+    of the nearest run within `NEAR_AXIS` of the object's width."""
+    h, w = mask.shape
+    cols = np.nonzero(mask.any(0))[0]
+    near = NEAR_AXIS * (cols.max() - cols.min() + 1)
+    left, right = np.full(h, np.nan), np.full(h, np.nan)
+    padded = np.zeros((h, w + 2), np.int8)
+    padded[:, 1:-1] = mask
+    steps = np.diff(padded, axis=1)
+    for y in np.nonzero(mask.any(1))[0]:
+        starts, ends = np.nonzero(steps[y] == 1)[0], np.nonzero(steps[y] == -1)[0]  # run [start, end)
+        centre = axis + 0.5
+        gap = np.maximum(starts - centre, 0) + np.maximum(centre - ends, 0)
+        i = int(np.argmin(gap))
+        if gap[i] <= near:
+            left[y], right[y] = centre - starts[i], ends[i] - centre
+    return left, right
+
+
+def _opening(profile: np.ndarray, span: int) -> np.ndarray:
+    """Grey opening of a 1-D profile (NaN = no object) with a window of `span` samples: peaks narrower than the
+    window are cut down to their surroundings."""
+    filled = np.where(np.isnan(profile), 0.0, profile).astype(np.float32)[:, None]
+    kernel = np.ones((max(1, span), 1), np.uint8)
+    eroded = cv2.erode(filled, kernel, borderType=cv2.BORDER_REPLICATE)
+    return cv2.dilate(eroded, kernel, borderType=cv2.BORDER_REPLICATE)[:, 0]
+
+
+def _keep_ends(radius: np.ndarray, opened: np.ndarray, tol: float, rows: np.ndarray) -> np.ndarray:
+    """The opened profile, except over bumps that start or end within `END_ROWS` of the first or last row: a
+    rim or a foot is the solid's own, a handle's attachment lies between body rows."""
+    out = opened.copy()
+    bump = np.zeros(len(radius) + 2, np.int8)
+    bump[1:-1] = np.nan_to_num(radius, nan=0.0) > opened + tol
+    edges = np.diff(bump)
+    near = END_ROWS * (rows.max() - rows.min() + 1)
+    for start, end in zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]):
+        if start <= rows.min() + near or end >= rows.max() - near:
+            out[start:end] = radius[start:end]
+    return out
+
+
+def upright_core(mask: np.ndarray, axis: float) -> np.ndarray:
+    """The symmetric core of an upright bool mask (axis vertical at x = `axis`)."""
+    left, right = _axis_runs(mask, axis)
+    rows = np.nonzero(~np.isnan(left))[0]
+    if len(rows) == 0:
+        return mask.copy()
+    cols = np.nonzero(mask.any(0))[0]
+    tol = SIDE_TOLERANCE * (cols.max() - cols.min() + 1)
+    radius = np.fmin(left, right)
+    opened = _opening(radius, int(round(BUMP_SPAN * (rows.max() - rows.min() + 1))))
+    limit = np.fmin(radius, _keep_ends(radius, opened, tol, rows)) + tol
+    xs = np.arange(mask.shape[1]) + 0.5 - (axis + 0.5)  # pixel centres relative to the axis
+    core = np.zeros_like(mask)
+    for y in rows:
+        core[y] = mask[y] & (xs >= -min(left[y], limit[y])) & (xs <= min(right[y], limit[y]))
+    return main_component(core)
+
+
+def symmetric_core(mask: np.ndarray) -> Core:
+    """Split a bool silhouette into its symmetric core and appendages.
+
+    Args:
+        mask: H x W bool silhouette (one object).
+
+    Returns:
+        Core; for an empty mask, an empty core with symmetry 0.
+    """
+    if not mask.any():
+        return Core(mask.copy(), np.zeros_like(mask), 0.0, 0.0, 0.0)
+    tilt, axis = find_axis(mask)
+    if tilt:
+        rot = _rotation(mask, tilt)
+        core = _warp(upright_core(_warp(mask, rot), axis), cv2.invertAffineTransform(rot)) & mask
+    else:
+        core = upright_core(mask, axis)
+    rest = mask & ~core
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(rest.astype(np.uint8), connectivity=8)
+    small = [i for i in range(1, n) if stats[i, cv2.CC_STAT_AREA] < MIN_APPENDAGE * mask.sum()]
+    if small:
+        core |= np.isin(labels, small)
+        rest &= ~core
+    return Core(core, rest, tilt, axis, sor_score(core))

@@ -1,0 +1,171 @@
+"""Find the one vessel of a photograph in any framing and cut its network crop: the object may touch the
+frame, the backdrop may fill it, the photo may be a cut-out (on white, or transparent), carry a label or colour
+chart, or show the vessel on a stand. The silhouette is split into its symmetric core and its appendages.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from radar_cli.errors import InputError
+from radar_cli.masks import crop as crops
+from radar_cli.masks.appendages import Core, symmetric_core
+from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale
+from radar_cli.masks.pipeline import Refined, Settings, check_photo, refine_detection, refine_window
+from radar_cli.masks.refine import main_component
+
+CUTOUT_MIN_CLEAR = 0.01  # an alpha channel with at least this share of clear pixels is a cut-out's silhouette
+STAND_MIN, STAND_MAX = 0.03, 0.6  # a stand's height as a fraction of the located height
+STAND_STEP = 0.08  # ... whose width differs from the vessel's foot above it by at least this fraction
+STAND_TOLERANCE = 0.015  # straight sides: the stand's edges move less than this fraction of the window per row
+STAND_COLOUR_STEP = 30.0  # ... and whose mean colour is this far (RGB levels) from the vessel's above it ...
+STAND_BIG_STEP = 0.25  # ... unless the width step is this large
+
+
+@dataclass(frozen=True)
+class Located:
+    """One vessel located in a photo and cut to the network's square crop.
+
+    Attributes:
+        image: S x S x 3 uint8 RGB crop (cut-outs composited on white).
+        silhouette: S x S bool, the symmetric core (what the network is asked to explain).
+        appendages: S x S bool, the rest of the located object (handles, spouts, knobs).
+        box: the crop's square window of the photo (may reach beyond the photo's edge).
+        cut_edges: the photo edges the object runs into (`top`, `bottom`, `left`, `right`).
+        frame_coverage: share of the photo the located object covers.
+        symmetry: solid-of-revolution score of the core.
+        stand_removed: whether a stand under the vessel was cut off.
+    """
+
+    image: np.ndarray
+    silhouette: np.ndarray
+    appendages: np.ndarray
+    box: crops.CropBox
+    cut_edges: tuple[str, ...]
+    frame_coverage: float
+    symmetry: float
+    stand_removed: bool = False
+
+    @property
+    def appendage_fraction(self) -> float:
+        total = int(self.silhouette.sum()) + int(self.appendages.sum())
+        return float(self.appendages.sum() / total) if total else 0.0
+
+
+def split_alpha(photo: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """H x W x 3 RGB on white and the H x W bool opaque mask of a cut-out (H x W x 4 with clear pixels), else
+    the photo and None."""
+    if photo.ndim != 3 or photo.shape[2] != 4:
+        return photo, None
+    alpha = photo[..., 3]
+    if (alpha < 128).mean() < CUTOUT_MIN_CLEAR or not (alpha >= 128).any():
+        return np.ascontiguousarray(photo[..., :3]), None
+    a = alpha[..., None].astype(np.float32) / 255.0
+    rgb = (photo[..., :3] * a + 255.0 * (1 - a) + 0.5).astype(np.uint8)
+    return rgb, alpha >= 128
+
+
+def alpha_detection(opaque: np.ndarray) -> Detection:
+    """The cut-out's largest opaque part as a detection at detection scale."""
+    small, scale = downscale(np.dstack([opaque.astype(np.uint8) * 255] * 3), WORK_SIDE)
+    mask = main_component(small[..., 0] > 127)
+    ys, xs = np.nonzero(mask)
+    if len(xs) == 0:
+        mask, (ys, xs) = small[..., 0] > 0, np.nonzero(small[..., 0] > 0)
+    box = (xs.min() / scale, ys.min() / scale, (xs.max() + 1) / scale, (ys.max() + 1) / scale)
+    return Detection(mask, box, 1.0, scale)
+
+
+def alpha_refined(rgb: np.ndarray, opaque: np.ndarray, found: Detection, settings: Settings) -> Refined:
+    """The cut-out's own silhouette in the refinement window (no GrabCut: the alpha channel is the answer)."""
+    window, work_side = refine_window(found, settings)
+    mask = main_component(crops.warp_mask(opaque, crops.crop_affine(window, work_side), work_side))
+    return Refined(mask, window, crops.outside_mask(window, opaque.shape, work_side), False,
+                   crops.cut(rgb, window, work_side))
+
+
+def _extents(mask: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Leftmost and rightmost object column of each of `rows` (each must hold object pixels)."""
+    cols = np.arange(mask.shape[1])
+    inside = mask[rows]
+    left = np.where(inside, cols, mask.shape[1]).min(1)
+    right = np.where(inside, cols, -1).max(1)
+    return left, right
+
+
+def remove_stand(mask: np.ndarray, image: np.ndarray) -> tuple[np.ndarray, bool]:
+    """Cut a stand off the bottom of a located object: the bottom rows with straight sides, a few percent to
+    under two thirds of the object's height, clearly wider or narrower than the vessel's foot above them and of
+    another colour unless the step is large (a vessel's own foot ring is of its glaze; a straight vessel cut by
+    the frame has no step).
+
+    Args:
+        mask: n x n bool located object. image: n x n x 3 uint8, the pixels it was located in.
+
+    Returns:
+        (mask without the stand, whether one was removed).
+    """
+    rows = np.nonzero(mask.any(1))[0]
+    if len(rows) < 10:
+        return mask, False
+    height = rows.max() - rows.min() + 1
+    left, right = _extents(mask, rows)
+    widths = right - left + 1
+    while len(rows) > 10 and widths[-1] < 0.5 * np.median(widths[-10:]):  # a ragged sliver under the stand
+        rows, left, right, widths = rows[:-1], left[:-1], right[:-1], widths[:-1]
+    tol = max(1.5, STAND_TOLERANCE * mask.shape[0])
+    k = len(rows) - 1
+    while k > 0 and abs(left[k - 1] - left[-1]) <= tol and abs(right[k - 1] - right[-1]) <= tol:
+        k -= 1
+    span = len(rows) - k
+    if not (STAND_MIN * height <= span <= STAND_MAX * height) or k < 4:
+        return mask, False
+    stand_w = right[-1] - left[-1] + 1
+    foot_w = float(np.mean(right[k - 4 : k] - left[k - 4 : k] + 1))
+    stand, above = mask.copy(), mask.copy()
+    stand[: rows[k]] = False
+    above[: rows[max(0, k - span)]] = False
+    above[rows[k]:] = False
+    colour_step = np.linalg.norm(image[stand].mean(0) - image[above].mean(0))
+    step = abs(foot_w - stand_w) / stand_w
+    if step < STAND_STEP or (colour_step < STAND_COLOUR_STEP and step < STAND_BIG_STEP):
+        return mask, False
+    return main_component(mask & ~stand), True
+
+
+def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: float = crops.DEFAULT_MARGIN) -> Located:
+    """Locate the vessel of a photo and cut its square crop around the symmetric core.
+
+    Args:
+        photo: H x W x 3 uint8 RGB, or H x W x 4 RGBA (a transparent cut-out's alpha is its silhouette).
+        size: S, the crop side.
+        name: the file, for messages.
+        margin: per-side margin of the crop around the core.
+
+    Returns:
+        Located; InputError if nothing stands out from the backdrop.
+    """
+    rgb, opaque = split_alpha(photo)
+    check_photo(rgb, name)
+    settings = Settings(size=size, margin=margin)
+    if opaque is not None:
+        found = alpha_detection(opaque)
+        refined = alpha_refined(rgb, opaque, found, settings)
+    else:
+        detections = detect(rgb, thorough=True)
+        if not detections:
+            raise InputError(f"{name}: no object stands out from the backdrop; crop it square or use --crop none")
+        found = detections[0]
+        refined = refine_detection(rgb, found, settings)
+    mask, stand = remove_stand(refined.mask, refined.image)
+    split: Core = symmetric_core(mask)
+    final, image, core = refined.framed(rgb, split.core, settings, fill=255)  # beyond the frame: white
+    _, _, whole = refined.framed(rgb, mask, settings, box_mask=split.core)
+    region = crops.valid_region(final, rgb.shape, size)
+    k = refined.window.side / mask.shape[0]
+    coverage = float(mask.sum() * k * k / (rgb.shape[0] * rgb.shape[1]))
+    return Located(image, core, whole & ~core, final, crops.cut_edges(whole, region), min(1.0, coverage),
+                   split.symmetry, stand)

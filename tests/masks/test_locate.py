@@ -1,0 +1,97 @@
+"""Locating a vessel in hard framings (tight crops, frame-filling backdrops, cut-outs, labels, stands) and
+splitting off its appendages, on rendered vases pasted over backdrops (the truth is known)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from radar_cli.errors import InputError
+from radar_cli.masks import crop as crops
+from radar_cli.masks.appendages import symmetric_core
+from radar_cli.masks.locate import locate_object, remove_stand
+from radar_cli.masks.refine import iou
+from radar_cli.masks.synthetic import composite, render_vases
+from radar_cli.masks.variants import KINDS, Variant, make_variant, with_handles
+
+SIZE = 128
+
+
+@pytest.fixture(scope="module")
+def sources() -> list[tuple[np.ndarray, np.ndarray]]:
+    """Two rendered vases pasted over a gradient studio backdrop: (photo, truth)."""
+    vases, alpha, masks = render_vases(2, 160, seed=3)
+    rng = np.random.default_rng(4)
+    return [composite(vases[i], alpha[i], masks[i], "gradient", rng, shape=(360, 300)) for i in range(2)]
+
+
+def located_iou(variant: Variant) -> tuple[float, object]:
+    found = locate_object(variant.image, SIZE)
+    truth = crops.cut(variant.truth.astype(np.float32), found.box, SIZE, fill=0) > 0.5
+    return iou(found.silhouette | found.appendages, truth), found
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_every_framing_is_located(sources: list, kind: str) -> None:
+    rng = np.random.default_rng(7)
+    for n, (photo, truth) in enumerate(sources):
+        score, found = located_iou(make_variant(kind, photo, truth, rng, index=n))
+        assert score >= 0.9, (kind, n, score)
+        assert found.frame_coverage < 0.9
+
+
+def test_tight_crop_records_the_cut_edges_and_pads_white(sources: list) -> None:
+    photo, truth = sources[0]
+    variant = make_variant("tight", photo, truth, np.random.default_rng(1))
+    _, found = located_iou(variant)
+    assert {"top", "bottom"} <= set(found.cut_edges) and not {"left", "right"} & set(found.cut_edges)
+    ys = np.nonzero(found.silhouette.any(1))[0]
+    assert ys.min() > 2 and ys.max() < SIZE - 3  # the crop shows the whole object with a margin, not streaks
+
+
+def test_rgba_cut_out_uses_its_alpha(sources: list) -> None:
+    photo, truth = sources[1]
+    variant = make_variant("rgba", photo, truth, np.random.default_rng(2))
+    assert variant.image.shape[2] == 4
+    score, found = located_iou(variant)
+    assert score >= 0.97 and found.image[0, 0].tolist() == [255, 255, 255]
+
+
+def test_stand_is_cut_off() -> None:
+    mask = np.zeros((100, 100), bool)
+    yy, xx = np.mgrid[0:100, 0:100]
+    mask |= ((xx - 50) / 20.0) ** 2 + ((yy - 45) / 30.0) ** 2 < 1  # the vessel, rows 15..75
+    mask[66:76, 35:65] = True  # its foot ring, 30 px wide
+    mask[76:, 33:67] = True  # a plinth to the bottom edge, a little wider than the foot (13 %)
+    image = np.full((100, 100, 3), 60, np.uint8)
+    image[76:] = 200
+    cut, removed = remove_stand(mask, image)
+    assert removed and not cut[80:].any() and cut[40].sum() == mask[40].sum() and cut[70].any()
+    assert not remove_stand(mask, np.full_like(image, 60))[1]  # the vessel's own colour and a small step: kept
+    wide = mask.copy()
+    wide[76:, 20:80] = True  # a much wider plinth goes whatever its colour
+    assert remove_stand(wide, np.full_like(image, 60))[1]
+    cylinder = np.zeros_like(mask)
+    cylinder[20:, 35:65] = True  # a straight-sided vessel cut by the frame is not a stand
+    assert not remove_stand(cylinder, image)[1]
+
+
+def test_handles_are_left_out_of_the_core(sources: list) -> None:
+    rng = np.random.default_rng(5)
+    for photo, truth in sources:
+        image, handled = with_handles(photo, truth, rng)
+        found = locate_object(image, SIZE)
+        core_truth = crops.cut(truth.astype(np.float32), found.box, SIZE, fill=0) > 0.5
+        assert iou(found.silhouette, core_truth) >= 0.9
+        assert found.appendage_fraction > 0.03
+
+
+def test_a_plain_solid_has_no_appendages(sources: list) -> None:
+    for _, truth in sources:
+        split = symmetric_core(truth)
+        assert split.appendage_fraction < 0.02 and split.symmetry > 0.85
+
+
+def test_blank_photo_is_one_clear_error() -> None:
+    with pytest.raises(InputError, match="blank.png"):
+        locate_object(np.full((120, 90, 3), 200, np.uint8), SIZE, "blank.png")
