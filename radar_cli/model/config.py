@@ -68,7 +68,7 @@ class LossConfig:
     dt_margin_px: float = 0.0
     """Pixels next to the target that the distance term leaves free (0 = the paper). The soft silhouette's own
     halo lies there; penalising it biases the fit towards smaller silhouettes, and at 64 px that bias swamps the
-    pitch cue of the rim (see README, Accuracy)."""
+    pitch cue of the rim (docs/training.md)."""
     im_weight: float = 1.0
     alb_weight: float = 1.0
     sad_weight: float = 0.01
