@@ -89,7 +89,7 @@ syn-data-cpu-format1: $(STAMP)
 # The bundled model's nine stages (docs/training.md; pipelines/cpu/syn_vases_cpu.toml, then pipelines/bundled/):
 # stages 1-8 on format-1 images, each but stage 4 starting from the one before with --init (stage 4 resumes
 # stage 3 with a second learning-rate ramp); stage 8 first de-renders the training vases with --pitch search for
-# its pitch labels; stage 9 fine-tunes stage 8 on today's images. --resume continues a killed fine-tune and a
+# its pitch labels; stage 9 fine-tunes stage 8 on format-2 images (`make syn-data-cpu`). --resume continues a killed fine-tune and a
 # re-run `radar derender` skips the objects it has finished.
 F1 := data/syn_cpu_format1
 train-syn-cpu: $(STAMP)
