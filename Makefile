@@ -86,10 +86,11 @@ syn-data-cpu-format1: $(STAMP)
 	cd build/synth_format1 && PYTHONPATH=. $(CURDIR)/$(BIN)/python -m radar_cli synth --out $(CURDIR)/data/syn_cpu_format1 \
 		--size 64 --workers $(WORKERS)
 
-# The bundled model's nine stages (docs/training.md; pipelines/cpu/syn_vases_cpu.toml, then pipelines/bundled/):
+# The bundled model's ten stages (docs/training.md; pipelines/cpu/syn_vases_cpu.toml, then pipelines/bundled/):
 # stages 1-8 on format-1 images, each but stage 4 starting from the one before with --init (stage 4 resumes
 # stage 3 with a second learning-rate ramp); stage 8 first de-renders the training vases with --pitch search for
-# its pitch labels; stage 9 fine-tunes stage 8 on format-2 images (`make syn-data-cpu`). --resume continues a killed fine-tune and a
+# its pitch labels; stage 9 fine-tunes stage 8 on format-2 images (`make syn-data-cpu`) and stage 10 repeats stage 8's
+# self-training on them. --resume continues a killed fine-tune and a
 # re-run `radar derender` skips the objects it has finished.
 F1 := data/syn_cpu_format1
 train-syn-cpu: $(STAMP)
@@ -121,6 +122,11 @@ train-syn-cpu: $(STAMP)
 	$(RADAR) train --config pipelines/bundled/stage9_finetune.toml --resume \
 		--init runs/syn_cpu_selftrain/model.safetensors --data data/syn_cpu --out runs/syn_cpu_finetune \
 		--device cpu $(TRAIN_THREADS)
+	$(RADAR) derender data/syn_cpu/train --checkpoint runs/syn_cpu_finetune/model.safetensors \
+		--out results/syn_cpu_f2_train_search --views 0 --pitch search --workers $(WORKERS)
+	$(RADAR) train --config pipelines/bundled/stage10_selftrain.toml --resume \
+		--init runs/syn_cpu_finetune/checkpoints/step_0002000.safetensors --pitch-labels results/syn_cpu_f2_train_search \
+		--data data/syn_cpu --out runs/syn_cpu_selftrain2 --device cpu $(TRAIN_THREADS)
 
 # The bundled model (or CPU_MODEL=runs/.../model.safetensors) on the 460 test vases of `make syn-data-cpu`
 CPU_MODEL ?=
