@@ -21,7 +21,7 @@ ALBEDO ?= network
 PITCH ?= network
 
 .PHONY: install demo test test-all test-gpu test-browser clean \
-        syn-data syn-data-cpu train-syn train-syn-cpu eval-syn eval-syn-cpu table2 table2-cpu \
+        syn-data syn-data-cpu syn-data-cpu-format1 train-syn train-syn-cpu eval-syn eval-syn-cpu table2 table2-cpu \
         met-fetch met-masks train-met real-vases bench
 
 $(STAMP): pyproject.toml
@@ -64,7 +64,7 @@ syn-data: $(STAMP)
 	$(RADAR) synth --out data/syn_vases --size 256 --workers $(WORKERS)
 
 train-syn: $(STAMP)
-	$(RADAR) train --config pipelines/syn_vases.toml --data data/syn_vases --out runs/syn_vases --device $(DEVICE) \
+	$(RADAR) train --config pipelines/paper/syn_vases.toml --data data/syn_vases --out runs/syn_vases --device $(DEVICE) \
 		$(TRAIN_ARGS)
 
 eval-syn: $(STAMP)
@@ -75,57 +75,77 @@ eval-syn: $(STAMP)
 # Every row of Table 2: the full model, the ablations and the supervised upper bound.
 table2: $(STAMP)
 	for p in syn_vases syn_vases_no_alb syn_vases_no_sad syn_vases_no_diff syn_vases_supervised; do \
-		$(RADAR) train --config pipelines/$$p.toml --data data/syn_vases --out runs/$$p --device $(DEVICE) && \
+		$(RADAR) train --config pipelines/paper/$$p.toml --data data/syn_vases --out runs/$$p --device $(DEVICE) && \
 		$(RADAR) derender data/syn_vases/test --checkpoint runs/$$p/model.safetensors --out results/$$p \
 			--views 0 --device $(DEVICE) --workers $(WORKERS) --albedo $(ALBEDO) --pitch $(PITCH) && \
 		$(RADAR) eval --pred results/$$p --gt data/syn_vases --json results/$$p/eval.json || exit 1; \
 	done
 
-# --- The same at CPU size (64 px): what the bundled model was trained with ---------------------------------
+# --- The same at CPU size (64 px): the bundled model's data, training and evaluation -------------------------
 syn-data-cpu: $(STAMP)
 	$(RADAR) synth --out data/syn_cpu --size 64 --workers $(WORKERS)
 
-# The bundled model's eight stages: the paper's losses, then a sharp silhouette, then the mouth term, then the
-# mouth term continued with a second learning-rate ramp (resumed from stage 3's last checkpoint), then the shape
-# cycle (a fine-tune of stage 4), then the lighting cycle as well (a fine-tune of stage 5), then both cycles
-# redrawing with the divided albedo (a fine-tune of stage 6), then self-training on pitch (a fine-tune of stage 7
-# towards the pitches its own `--pitch search` finds on the training vases); --resume continues a killed fine-tune
-# and a re-run `radar derender` skips the objects it has finished.
+# Stages 1-8 of the bundled model were trained on synthesis format 1, the images `radar synth` drew before its edge
+# pixels were blended with the background (docs/formats.md); this makes them with that commit's generator.
+FORMAT1_COMMIT := 9b29213
+syn-data-cpu-format1: $(STAMP)
+	rm -rf build/synth_format1 && mkdir -p build/synth_format1
+	git archive $(FORMAT1_COMMIT) radar_cli | tar -x -C build/synth_format1
+	cd build/synth_format1 && PYTHONPATH=. $(CURDIR)/$(BIN)/python -m radar_cli synth --out $(CURDIR)/data/syn_cpu_format1 \
+		--size 64 --workers $(WORKERS)
+
+# The bundled model's ten stages (docs/training.md; pipelines/cpu/syn_vases_cpu.toml, then pipelines/bundled/):
+# stages 1-8 on format-1 images, each but stage 4 starting from the one before with --init (stage 4 resumes
+# stage 3 with a second learning-rate ramp); stage 8 first de-renders the training vases with --pitch search for
+# its pitch labels; stage 9 fine-tunes stage 8 on format-2 images (`make syn-data-cpu`) and stage 10 repeats stage 8's
+# self-training on them. --resume continues a killed fine-tune and a
+# re-run `radar derender` skips the objects it has finished.
+F1 := data/syn_cpu_format1
 train-syn-cpu: $(STAMP)
-	$(RADAR) train --config pipelines/syn_vases_cpu.toml --data data/syn_cpu --out runs/syn_cpu --device cpu $(TRAIN_THREADS)
-	$(RADAR) train --config pipelines/syn_vases_cpu_sharp.toml --init runs/syn_cpu/checkpoints/step_0006500.safetensors \
-		--data data/syn_cpu --out runs/syn_cpu_sharp --device cpu $(TRAIN_THREADS)
-	$(RADAR) train --config pipelines/syn_vases_cpu_mouth.toml \
-		--init runs/syn_cpu_sharp/checkpoints/step_0004500.safetensors --data data/syn_cpu --out runs/syn_cpu_mouth \
+	$(RADAR) train --config pipelines/cpu/syn_vases_cpu.toml --data $(F1) --out runs/syn_cpu --device cpu $(TRAIN_THREADS)
+	$(RADAR) train --config pipelines/bundled/stage2_sharp.toml --init runs/syn_cpu/checkpoints/step_0006500.safetensors \
+		--data $(F1) --out runs/syn_cpu_sharp --device cpu $(TRAIN_THREADS)
+	$(RADAR) train --config pipelines/bundled/stage3_mouth.toml \
+		--init runs/syn_cpu_sharp/checkpoints/step_0004500.safetensors --data $(F1) --out runs/syn_cpu_mouth \
 		--device cpu $(TRAIN_THREADS)
 	mkdir -p runs/syn_cpu_mouth_long/checkpoints
 	test -n "$$(ls runs/syn_cpu_mouth_long/checkpoints)" || \
 		cp runs/syn_cpu_mouth/checkpoints/step_0018000.safetensors runs/syn_cpu_mouth_long/checkpoints/
-	$(RADAR) train --config pipelines/syn_vases_cpu_mouth_long.toml --resume --data data/syn_cpu \
+	$(RADAR) train --config pipelines/bundled/stage4_mouth_long.toml --resume --data $(F1) \
 		--out runs/syn_cpu_mouth_long --device cpu $(TRAIN_THREADS)
-	$(RADAR) train --config pipelines/syn_vases_cpu_cycle.toml --resume \
-		--init runs/syn_cpu_mouth_long/checkpoints/step_0027000.safetensors --data data/syn_cpu \
+	$(RADAR) train --config pipelines/bundled/stage5_cycle.toml --resume \
+		--init runs/syn_cpu_mouth_long/checkpoints/step_0027000.safetensors --data $(F1) \
 		--out runs/syn_cpu_cycle --device cpu $(TRAIN_THREADS)
-	$(RADAR) train --config pipelines/syn_vases_cpu_light.toml --resume \
-		--init runs/syn_cpu_cycle/checkpoints/step_0004000.safetensors --data data/syn_cpu \
+	$(RADAR) train --config pipelines/bundled/stage6_light.toml --resume \
+		--init runs/syn_cpu_cycle/checkpoints/step_0004000.safetensors --data $(F1) \
 		--out runs/syn_cpu_light --device cpu $(TRAIN_THREADS)
-	$(RADAR) train --config pipelines/syn_vases_cpu_divided.toml --resume \
-		--init runs/syn_cpu_light/checkpoints/step_0004000.safetensors --data data/syn_cpu \
+	$(RADAR) train --config pipelines/bundled/stage7_divided.toml --resume \
+		--init runs/syn_cpu_light/checkpoints/step_0004000.safetensors --data $(F1) \
 		--out runs/syn_cpu_divided --device cpu $(TRAIN_THREADS)
-	$(RADAR) derender data/syn_cpu/train --checkpoint runs/syn_cpu_divided/model.safetensors \
+	$(RADAR) derender $(F1)/train --checkpoint runs/syn_cpu_divided/model.safetensors \
 		--out results/syn_cpu_train_search --views 0 --pitch search --workers $(WORKERS)
-	$(RADAR) train --config pipelines/syn_vases_cpu_selftrain.toml --resume \
+	$(RADAR) train --config pipelines/bundled/stage8_selftrain.toml --resume \
 		--init runs/syn_cpu_divided/checkpoints/step_0002000.safetensors --pitch-labels results/syn_cpu_train_search \
-		--data data/syn_cpu --out runs/syn_cpu_selftrain --device cpu $(TRAIN_THREADS)
+		--data $(F1) --out runs/syn_cpu_selftrain --device cpu $(TRAIN_THREADS)
+	$(RADAR) train --config pipelines/bundled/stage9_finetune.toml --resume \
+		--init runs/syn_cpu_selftrain/model.safetensors --data data/syn_cpu --out runs/syn_cpu_finetune \
+		--device cpu $(TRAIN_THREADS)
+	$(RADAR) derender data/syn_cpu/train --checkpoint runs/syn_cpu_finetune/model.safetensors \
+		--out results/syn_cpu_f2_train_search --views 0 --pitch search --workers $(WORKERS)
+	$(RADAR) train --config pipelines/bundled/stage10_selftrain.toml --resume \
+		--init runs/syn_cpu_finetune/checkpoints/step_0002000.safetensors --pitch-labels results/syn_cpu_f2_train_search \
+		--data data/syn_cpu --out runs/syn_cpu_selftrain2 --device cpu $(TRAIN_THREADS)
 
+# The bundled model (or CPU_MODEL=runs/.../model.safetensors) on the 460 test vases of `make syn-data-cpu`
+CPU_MODEL ?=
 eval-syn-cpu: $(STAMP)
-	$(RADAR) derender data/syn_cpu/test --checkpoint runs/syn_cpu_selftrain/model.safetensors --out results/syn_cpu \
-		--views 0 --albedo $(ALBEDO) --pitch $(PITCH)
+	$(RADAR) derender data/syn_cpu/test $(if $(CPU_MODEL),--checkpoint $(CPU_MODEL),) --out results/syn_cpu \
+		--overwrite --views 0 --albedo $(ALBEDO) --pitch $(PITCH) --workers $(WORKERS)
 	$(RADAR) eval --pred results/syn_cpu --gt data/syn_cpu --json results/syn_cpu/eval.json
 
 table2-cpu: $(STAMP)
 	for p in syn_vases_cpu syn_vases_cpu_no_alb syn_vases_cpu_no_sad syn_vases_cpu_no_diff syn_vases_cpu_supervised; do \
-		$(RADAR) train --config pipelines/$$p.toml --data data/syn_cpu --out runs/$$p --device cpu $(TRAIN_THREADS) && \
+		$(RADAR) train --config pipelines/cpu/$$p.toml --data data/syn_cpu --out runs/$$p --device cpu $(TRAIN_THREADS) && \
 		$(RADAR) derender data/syn_cpu/test --checkpoint runs/$$p/model.safetensors --out results/$$p --views 0 \
 			--albedo $(ALBEDO) --pitch $(PITCH) && \
 		$(RADAR) eval --pred results/$$p --gt data/syn_cpu --json results/$$p/eval.json || exit 1; \
@@ -139,7 +159,7 @@ met-masks: $(STAMP)
 	$(RADAR) masks data/met --out data/met_prepared --size 256 --workers $(WORKERS)
 
 train-met: $(STAMP)
-	$(RADAR) train --config pipelines/met_vases.toml --data data/met_prepared --out runs/met_vases --device $(DEVICE) \
+	$(RADAR) train --config pipelines/paper/met_vases.toml --data data/met_prepared --out runs/met_vases --device $(DEVICE) \
 		$(TRAIN_ARGS)
 
 # --- The 12 real photographs beside the repo, de-rendered by the bundled model, with a contact sheet ----------
@@ -149,7 +169,7 @@ real-vases: $(STAMP)
 
 bench: $(STAMP)
 	$(RADAR) bench render --device $(DEVICE)
-	$(RADAR) bench train --config pipelines/syn_vases_cpu.toml
+	$(RADAR) bench train --config pipelines/cpu/syn_vases_cpu.toml
 	$(RADAR) bench masks
 	$(RADAR) bench synth
 	$(RADAR) bench derender

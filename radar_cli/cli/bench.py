@@ -35,7 +35,7 @@ def render(device: str, sizes: str, batch: int, repeats: int, threads: int) -> N
 
 
 @bench.command("train")
-@click.option("--config", "config_path", default="pipelines/syn_vases_cpu.toml", show_default=True,
+@click.option("--config", "config_path", default="pipelines/cpu/syn_vases_cpu.toml", show_default=True,
               type=click.Path(dir_okay=False), help="Preset TOML to time.")
 @click.option("--device", default="auto", show_default=True, type=click.Choice(["cpu", "cuda", "auto"]))
 @click.option("--steps", default=5, show_default=True, type=click.IntRange(min=1), help="Timed steps (median).")

@@ -6,7 +6,7 @@ import os
 
 import click
 
-from radar_cli.synth.generator import SynthConfig, generate
+from radar_cli.synth.generator import FORMAT_VERSION, SynthConfig, generate
 from radar_cli.synth.layout import DEFAULT_SPLIT_SIZES, FAILURES_FILE
 
 
@@ -47,7 +47,8 @@ def synth(out: str, n: int | None, size: int, seed: int, split: str, textures: s
     sizes = split_sizes(split, n)
     summary = generate(out, sizes, cfg, workers=workers)
     click.echo(f"synth: {summary.written} written, {summary.skipped} already done, {len(summary.failed)} failed "
-               f"in {summary.seconds:.1f} s ({summary.rate:.2f} samples/s, {workers} worker(s)) -> {out}")
+               f"in {summary.seconds:.1f} s ({summary.rate:.2f} samples/s, {workers} worker(s)) -> {out} "
+               f"(synthesis format {FORMAT_VERSION})")
     if summary.failed:
         click.echo(f"failures listed in {os.path.join(out, FAILURES_FILE)}", err=True)
         raise SystemExit(1)

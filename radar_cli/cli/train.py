@@ -1,4 +1,4 @@
-"""`radar train`: train RADAR from a pipelines/*.toml preset on a dataset folder."""
+"""`radar train`: train RADAR from a pipelines/**/*.toml preset on a dataset folder."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ OUT_OF_TIME_STATUS = 3
 
 @click.command("train")
 @click.option("--config", "config_path", required=True, type=click.Path(dir_okay=False),
-              help="Preset TOML, e.g. pipelines/syn_vases_cpu.toml.")
+              help="Preset TOML, e.g. pipelines/cpu/syn_vases_cpu.toml (pipelines/README.md lists them).")
 @click.option("--data", "data_dir", required=True, type=click.Path(file_okay=False),
               help="Dataset root holding train/<id>/image.png + mask.png.")
 @click.option("--out", "run_dir", required=True, type=click.Path(file_okay=False),

@@ -1,11 +1,11 @@
 """Test-time pitch by analysis by synthesis (radar's addition; `radar derender --pitch search`).
 
-f_S reads pitch from the image in one pass and leans towards the middle of the range (README, Accuracy). Given
+f_S reads pitch from the image in one pass and leans towards the middle of the range (docs/accuracy.md). Given
 the object's silhouette, the search tries pitches over the whole range: at each, f_L and f_A re-read the texture
 unwrapped at that pitch (f_S's radius, height, roll and translation held), the prediction is rendered and scored
 with the training's own terms (silhouette, reconstruction, mean-colour reconstruction), plus a weak pull towards
 f_S's pitch; a coarse grid, a fine grid round the best coarse pitch, then a parabola through the best fine pitch
-and its neighbours. Weights chosen on 256 training vases (README, Accuracy), not on the test set.
+and its neighbours. Weights chosen on 256 training vases (docs/derender.md), not on the test set.
 """
 
 from __future__ import annotations

@@ -70,7 +70,7 @@ class Predictor:
         version: a label recorded in every material.json (checkpoint name and hash).
         device: where the model runs.
         albedo: `divided`: the input's texture divided by the predicted shading (render.scene.divide_shading;
-            README, Accuracy: albedo si-MSE 4.01 -> 2.33 x 1e-2 with the bundled stage-6 model); `network`: f_A's
+            about 0.6x the albedo error of f_A's on synthetic vases, docs/accuracy.md); `network`: f_A's
             albedo, as the paper.
         pitch: `network`: f_S's pitch; `search`: derender.pitch_search where the silhouette is known (needs a
             RadarModel), f_S's elsewhere.

@@ -1,6 +1,6 @@
 """Typed configuration of a training run: the model (architecture, sizes, output ranges), the losses and the loop.
 
-One root `RunConfig` is loaded strictly from a `pipelines/*.toml` file and stored inside every checkpoint, so
+One root `RunConfig` is loaded strictly from a `pipelines/**/*.toml` file and stored inside every checkpoint, so
 inference needs only the checkpoint. Defaults are the paper's (supplementary Table 4).
 """
 
@@ -68,7 +68,7 @@ class LossConfig:
     dt_margin_px: float = 0.0
     """Pixels next to the target that the distance term leaves free (0 = the paper). The soft silhouette's own
     halo lies there; penalising it biases the fit towards smaller silhouettes, and at 64 px that bias swamps the
-    pitch cue of the rim (see README, Accuracy)."""
+    pitch cue of the rim (docs/training.md)."""
     im_weight: float = 1.0
     alb_weight: float = 1.0
     sad_weight: float = 0.01
@@ -134,7 +134,7 @@ class TrainConfig:
 
 @dataclass(frozen=True)
 class RunConfig:
-    """The root of a pipelines/*.toml file."""
+    """The root of a pipelines/**/*.toml file."""
 
     name: str = "run"
     model: ModelConfig = field(default_factory=ModelConfig)
@@ -163,7 +163,7 @@ class RunConfig:
 
 
 def load_run_config(path: str | Path) -> RunConfig:
-    """Load and validate a pipelines/*.toml file (unknown keys and wrong types raise ConfigError)."""
+    """Load and validate a pipelines/**/*.toml file (unknown keys and wrong types raise ConfigError)."""
     return load_toml(RunConfig, path).validate()
 
 

@@ -4,7 +4,7 @@ A pixel looks through the mouth when its ray crosses the rim's plane y = +h (can
 rho < r_top, before anything else (the camera sits above the plane for pitch >= 0, so nothing can come first).
 The coverage sigmoid((r_top - rho) / sigma) is smooth in the radius column, the height and the pose, so the
 mouth's projected ellipse, whose depth is r_top sin(pitch), can be fitted to an image where the inside is
-darker than the outside: a pitch cue that the outline alone barely carries at low resolution (README, Training).
+darker than the outside: a pitch cue that the outline alone barely carries at low resolution (docs/training.md).
 """
 
 from __future__ import annotations

@@ -34,7 +34,9 @@ from radar_cli.synth.render import env_preview, render_sample
 from radar_cli.synth.shapes import sample_shape
 from radar_cli.synth.textures import augment, image_texture, list_texture_images, procedural_texture
 
-FORMAT_VERSION = 1
+# What the written samples look like, recorded in synth.json and every params.json; raised whenever the same seed
+# would draw different pixels (tests/synth/test_pinned_output.py pins them; docs/formats.md lists the versions).
+FORMAT_VERSION = 2
 DEFAULT_SHADING = 32  # rows (and frontal-third columns) of the lighting grid when shading_size = 0
 MAX_SIZE = 1024
 PARTIAL_DIR = ".partial"  # samples being written; removed at the start of every run

@@ -34,7 +34,7 @@ def bench_train(config: RunConfig | str | Path, steps: int = 5, warmup: int = 2,
     """Time full training steps (model + D forward, backward, Adam) of a preset.
 
     Args:
-        config: a RunConfig or the path of a pipelines/*.toml preset.
+        config: a RunConfig or the path of a pipelines/**/*.toml preset.
         steps: timed steps (after `warmup` untimed ones).
         batch_size: overrides train.batch_size.
         device: "auto", "cpu" or "cuda".

@@ -151,7 +151,7 @@ def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: 
     """Train RADAR on DATA/train and write checkpoints, metrics and images to run_dir.
 
     Args:
-        config: the run's configuration (pipelines/*.toml).
+        config: the run's configuration (pipelines/**/*.toml).
         data_dir: dataset root holding train/<id>/image.png + mask.png.
         run_dir: output folder (created).
         resume: continue from the newest checkpoint in run_dir.

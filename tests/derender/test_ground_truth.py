@@ -82,7 +82,7 @@ def test_ground_truth_round_trip(tmp_path: Path) -> None:
     assert not report.problems and len(report.scores) == 2  # radar eval reads the layout as written
     for score in report.scores:
         assert score.pitch < 1e-3 and score.alpha < 1e-2 and score.rho < 1e-3 and score.normal < 2.0
-        assert score.albedo < 1e-3 < score.albedo_no_decomposition  # was 6e-3 with a white outline halo
+        assert score.albedo < 1e-3 < score.albedo_no_decomposition  # a white halo at the outline scores ~6e-3
 
 
 def test_divided_albedo_with_true_shading(tmp_path: Path) -> None:

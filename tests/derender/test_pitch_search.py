@@ -39,7 +39,7 @@ def test_flat_scores_give_no_offset() -> None:
 def test_search_finds_the_pitch_a_silhouette_was_drawn_at() -> None:
     """With the silhouette term alone and outlines drawn from f_S's own profile at known pitches, the search lands
     near each pitch whatever f_S said (at 64 px a hard outline pins pitch to about a degree: measured mean error
-    0.76 deg over these nine, 1.5 at most; f_S 4.7), and it keeps f_S's profile and the rest of the pose."""
+    0.57 deg over these nine, 1.6 at most; f_S 4.6), and it keeps f_S's profile and the rest of the pose."""
     from PIL import Image
 
     from radar_cli.render.raycast import cast_rays

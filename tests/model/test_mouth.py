@@ -1,5 +1,5 @@
 """The mouth term: its soft coverage is the set of rays that enter the vessel, and fitting the darker inside
-pulls the pitch towards the truth from either side (radar's addition; README, Training)."""
+pulls the pitch towards the truth from either side (radar's addition; docs/training.md)."""
 
 from __future__ import annotations
 

@@ -39,7 +39,7 @@ def test_tiny_model_outputs(tiny):
     check_decomposition(d, tiny, 3)
 
 
-@pytest.mark.parametrize("preset", ["syn_vases_cpu.toml", "met_vases_cpu.toml"])
+@pytest.mark.parametrize("preset", ["cpu/syn_vases_cpu.toml", "cpu/met_vases_cpu.toml"])
 def test_cpu_presets_outputs(preset):
     config = load_run_config(PIPELINES / preset)
     model = RadarModel(config.model)
@@ -50,7 +50,7 @@ def test_cpu_presets_outputs(preset):
 
 def test_paper_preset_architecture():
     """The 256 px model builds with the paper's layer counts (U-Net depth 6, 32-row radius column)."""
-    config = load_run_config(PIPELINES / "syn_vases.toml")
+    config = load_run_config(PIPELINES / "paper" / "syn_vases.toml")
     model = RadarModel(config.model)
     assert len(model.albedo_net.down) == 6
     convs = [m for m in model.shape_net.encoder if isinstance(m, torch.nn.Conv2d)]
@@ -71,12 +71,12 @@ def test_wrong_image_size_is_rejected(tiny):
 
 
 def test_all_presets_load_strictly(tmp_path):
-    for path in sorted(PIPELINES.glob("*.toml")):
+    for path in sorted(PIPELINES.rglob("*.toml")):
         load_run_config(path)
     bad = tmp_path / "bad.toml"
-    bad.write_text((PIPELINES / "syn_vases_cpu.toml").read_text() + "\n[extra]\nx = 1\n")
+    bad.write_text((PIPELINES / "cpu" / "syn_vases_cpu.toml").read_text() + "\n[extra]\nx = 1\n")
     with pytest.raises(ConfigError, match="unknown key"):
         load_run_config(bad)
-    bad.write_text((PIPELINES / "syn_vases_cpu.toml").read_text().replace("sad_patch = 16", "sad_patch = 12"))
+    bad.write_text((PIPELINES / "cpu" / "syn_vases_cpu.toml").read_text().replace("sad_patch = 16", "sad_patch = 12"))
     with pytest.raises(ConfigError, match="sad_patch"):
         load_run_config(bad)

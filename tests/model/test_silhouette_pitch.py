@@ -1,6 +1,6 @@
 """The silhouette loss as a pitch estimator at 64 px: with the true radius column and height, where along pitch
 does L_sil have its minimum? The paper's setting (sigma 1 px, no margin) is biased several degrees low there;
-the sharp setting of pipelines/syn_vases_cpu_sharp.toml (sigma 0.25 px, 1 px margin) is not (README, Training)."""
+the sharp setting of pipelines/bundled/stage2_sharp.toml (sigma 0.25 px, 1 px margin) is not (docs/training.md)."""
 
 from __future__ import annotations
 

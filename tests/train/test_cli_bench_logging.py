@@ -15,7 +15,7 @@ from radar_cli.train.logging import loss_curve
 
 from .conftest import tiny_config
 
-PRESET = Path(__file__).resolve().parents[2] / "pipelines" / "syn_vases_cpu.toml"
+PRESET = Path(__file__).resolve().parents[2] / "pipelines" / "cpu" / "syn_vases_cpu.toml"
 
 
 def test_train_command_runs_the_cpu_preset(vases64, tmp_path):

@@ -20,7 +20,7 @@ from radar_cli.train.trainer import train
 
 from .conftest import tiny_config
 
-PRESET = Path(__file__).resolve().parents[2] / "pipelines" / "syn_vases_cpu_selftrain.toml"
+PRESET = Path(__file__).resolve().parents[2] / "pipelines" / "bundled" / "stage8_selftrain.toml"
 
 
 def write_labels(results: Path, dataset: Path, pitches: dict[str, float]) -> Path:
@@ -97,7 +97,7 @@ def test_runs_with_labels_and_refuses_without(vases32, tmp_path):
 
 
 def test_the_preset_trains_from_the_cli_with_labels(vases64, tmp_path):
-    """pipelines/syn_vases_cpu_selftrain.toml through `radar train --pitch-labels`; without them, one line."""
+    """pipelines/bundled/stage8_selftrain.toml through `radar train --pitch-labels`; without them, one line."""
     ids = [r.sample_id for r in VaseDataset(vases64, "train", 64).refs]
     results = write_labels(tmp_path / "res", vases64, {i: 7.0 for i in ids})
     args = ["train", "--config", str(PRESET), "--data", str(vases64), "--out", str(tmp_path / "run"),
