@@ -201,6 +201,9 @@ def _export_all(ok: list[tuple[InputItem, Prepared]], todo: set[str], dec: Decom
     and torch's operations release the GIL, and each object writes its own folder); an error costs that object
     only."""
     def one(k: int) -> Failure | None:
+        # OpenMP's thread count is per thread: a pool thread would otherwise spin up every core, and sum in
+        # another order than a one-worker run (different bytes)
+        torch.set_num_threads(EXPORT_THREADS)
         item, prep = ok[k]
         try:
             refined, report = predictor.refine_object(dec.select(k), prep.image, prep.photo_image,

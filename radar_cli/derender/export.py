@@ -69,7 +69,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
     write_picture(folder / INPUT_FILE, prepared.photo_image)
     if prepared.photo_silhouette is not None:
         write_picture(folder / SILHOUETTE_FILE, prepared.photo_silhouette.astype(np.uint8) * 255)
-    if prepared.appendages is not None:
+    if prepared.appendages is not None and prepared.appendages.any():  # written only where something was left out
         write_picture(folder / APPENDAGES_FILE, prepared.appendages.astype(np.uint8) * 255)
     write_maps(folder, state, setup.render)
     write_meshes(folder, state, setup.geometry.n_cols)

@@ -84,6 +84,7 @@ class ShapeFit:
 
 
 def huber(d: torch.Tensor, delta: float = 1.0) -> torch.Tensor:
+    """Huber's loss of distances d (px): quadratic within delta, linear beyond (a stray mask pixel costs little)."""
     a = d.abs()
     return torch.where(a < delta, 0.5 * a * a, delta * (a - 0.5 * delta))
 

@@ -216,6 +216,7 @@ def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float) ->
     tri[seed] = cv2.GC_PR_FGD
     tri[backdrop_seeds(image)] = cv2.GC_BGD
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
+    cv2.setRNGSeed(0)  # GrabCut's k-means draws from a per-thread generator: the same cut in any thread
     try:
         cv2.grabCut(np.ascontiguousarray(image), tri, None, bgd, fgd, COARSE_ITERATIONS, cv2.GC_INIT_WITH_MASK)
     except cv2.error:

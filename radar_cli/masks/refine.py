@@ -138,6 +138,7 @@ def _refine(image: np.ndarray, rough: np.ndarray, iterations: int, sure: np.ndar
     if not (tri == cv2.GC_FGD).any() or not (tri == cv2.GC_BGD).any():
         return clean(rough, sigma), False
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
+    cv2.setRNGSeed(0)  # GrabCut's k-means draws from a per-thread generator: the same cut in any thread
     try:
         cv2.grabCut(np.ascontiguousarray(gc_img), tri, None, bgd, fgd, iterations, cv2.GC_INIT_WITH_MASK)
     except cv2.error:

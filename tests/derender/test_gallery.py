@@ -57,6 +57,9 @@ def results(tmp_path_factory) -> Path:
         material = json.loads((out / name / "material.json").read_text())
         material["quality"] = quality
         (out / name / "material.json").write_text(json.dumps(material))
+    plain = json.loads((out / "d_plain" / "material.json").read_text())
+    plain.pop("quality")  # a result written without a quality record
+    (out / "d_plain" / "material.json").write_text(json.dumps(plain))
     Image.new("RGB", (40, 40), (255, 0, 0)).save(out / "c_review" / "appendages.png")
     write_report(out, [])
     return out

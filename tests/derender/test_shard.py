@@ -96,7 +96,7 @@ def test_cli_rejects_a_bad_shard(photos: Path, tmp_path: Path) -> None:
 
 def _derender_cmd(photos: Path, out: Path, nproc: int) -> list[str]:
     args = ["-m", "radar_cli", "derender", str(photos), "--out", str(out), "--views", "0", "--view-size", "32",
-            "--batch-size", "2", "--workers", "1", "--device", "cpu"]
+            "--batch-size", "2", "--workers", "1", "--device", "cpu", "--refine", "none"]
     if nproc == 1:
         return [sys.executable, *args]
     return [sys.executable, "-m", "torch.distributed.run", "--standalone", f"--nproc_per_node={nproc}", *args]
