@@ -76,7 +76,7 @@ def test_sigkill_then_resume_equals_uninterrupted_run(met_server, tmp_path):
 def test_ctrl_c_prints_a_summary_and_exits_130(met_server, tmp_path):
     for i in range(1, 21):
         met_server.add(i)
-    met_server.delay = 0.02
+    met_server.delay = 0.1  # the other 35 requests take 3.5 s: the interrupt lands mid-run even on a busy machine
     proc = subprocess.Popen(command(met_server, tmp_path / "data"), cwd=REPO, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 30
