@@ -64,7 +64,7 @@ def browser():
 
 @pytest.fixture(scope="module")
 def results(tmp_path_factory) -> Path:
-    """The example photos de-rendered by the bundled model; one object marked for review by a quality record and
+    """The six synthetic example vases de-rendered by the bundled model; one object marked for review by a quality record and
     attributed as if its photo came from `radar masks` (a meta.json beside it)."""
     out = tmp_path_factory.mktemp("browser") / "results"
     sample = out.parent / "prepared" / "test" / "met_1"
@@ -73,7 +73,8 @@ def results(tmp_path_factory) -> Path:
         "object_id": 1, "title": "Storage jar", "credit_line": "Rogers Fund, 1917", "licence": "CC0",
         "object_url": "https://www.metmuseum.org/art/collection/search/1"}}))
     options = DerenderOptions(out=out, export=ExportConfig(views=4, view_size=128))
-    summary = derender([REPO / "examples"], Predictor.from_checkpoint(device="cpu"), options)
+    synthetic = sorted((REPO / "examples").glob("synthetic_vase_*.png"))
+    summary = derender(synthetic, Predictor.from_checkpoint(device="cpu"), options)
     assert len(summary.done) == 6 and not summary.failures
     material = json.loads((out / "synthetic_vase_3" / "material.json").read_text())
     material["quality"] = {"status": "review", "reasons": ["symmetry 0.61 < 0.8"], "silhouette_iou": 0.9,
