@@ -13,7 +13,10 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[2]
 # The `fetch` command module loaded by path: importing radar_cli.cli would import every other subcommand
 # (torch included, seconds per process on 2 busy cores) for nothing.
-FETCH = ("import importlib.util as u; s = u.spec_from_file_location('fetch', 'radar_cli/cli/fetch.py'); "
+# Ctrl-C's default handler restored first: a child inherits an ignored SIGINT from its parent (as some runners
+# and earlier tests leave it), and Python then never raises KeyboardInterrupt.
+FETCH = ("import signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
+         "import importlib.util as u; s = u.spec_from_file_location('fetch', 'radar_cli/cli/fetch.py'); "
          "m = u.module_from_spec(s); s.loader.exec_module(m); m.fetch()")
 N = 40
 
