@@ -12,7 +12,7 @@ from radar_cli.derender.inputs import InputItem, Prepared
 from radar_cli.derender.maps import write_maps, write_picture
 from radar_cli.derender.mesh import write_meshes
 from radar_cli.derender.predictor import AlbedoSource, ModelSetup, PitchSource
-from radar_cli.derender.quality import assess
+from radar_cli.derender.quality import assess_drawn
 from radar_cli.derender.renders import write_renders
 from radar_cli.derender.state import ObjectState
 from radar_cli.fileio import write_json
@@ -73,7 +73,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         write_picture(folder / APPENDAGES_FILE, prepared.appendages.astype(np.uint8) * 255)
     write_maps(folder, state, setup.render)
     write_meshes(folder, state, setup.geometry.n_cols)
-    write_renders(folder, state, side, config.view_side(side), config.views, envs)
+    drawn, recon = write_renders(folder, state, side, config.view_side(side), config.views, envs)
     record = state.material()
     record.update({
         "source": str(item.image_path),
@@ -88,7 +88,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         "pitch_source": pitch_source,
         **({"refine": refine} if refine is not None else {}),
         "environments": sorted(envs),
-        "quality": assess(prepared, state),
+        "quality": assess_drawn(prepared, drawn, recon),
     })
     write_json(folder / MATERIAL_FILE, record)
     return record

@@ -209,16 +209,13 @@ def _unique(found: list[InputItem], failures: list[Failure]) -> list[InputItem]:
 
 def resize_mask(mask: np.ndarray, side: int) -> np.ndarray:
     """An H x H bool mask at side x side: its coverage resampled (area down, bilinear up) and cut at 0.5."""
-    import cv2
-
     if mask.shape[0] == side:
         return mask
-    interp = cv2.INTER_AREA if mask.shape[0] > side else cv2.INTER_LINEAR
-    return cv2.resize(mask.astype(np.float32), (side, side), interpolation=interp) > 0.5
+    return resize_image(mask.astype(np.float32), side) > 0.5
 
 
 def resize_image(image: np.ndarray, side: int) -> np.ndarray:
-    """An H x H x 3 uint8 image at side x side (area down, bilinear up)."""
+    """An H x H (x C) image at side x side (area down, bilinear up)."""
     import cv2
 
     if image.shape[0] == side:

@@ -103,7 +103,8 @@ def judge(record: dict, limits: QualityLimits = QualityLimits()) -> tuple[str, l
 
 
 def assess(prepared: Prepared, state: ObjectState, limits: QualityLimits = QualityLimits()) -> dict:
-    """The `quality` record of one de-rendered object: its scores, status and reasons.
+    """The `quality` record of one de-rendered object, drawing it in the input view first (export_object has
+    that view already and calls assess_drawn).
 
     Args:
         prepared: the input crop and its located silhouette.
@@ -111,8 +112,18 @@ def assess(prepared: Prepared, state: ObjectState, limits: QualityLimits = Quali
         limits: the thresholds.
     """
     view = ViewRenderer(state, prepared.side)
-    rendered = view.hits.mask[0].numpy()  # N x N bool
-    recon = view.draw(view.shading())  # N x N x 3 uint8 over white
+    return assess_drawn(prepared, view.hits.mask[0].numpy(), view.draw(view.shading()), limits)
+
+
+def assess_drawn(prepared: Prepared, rendered: np.ndarray, recon: np.ndarray,
+                 limits: QualityLimits = QualityLimits()) -> dict:
+    """The `quality` record from the object drawn in the input view: its scores, status and reasons.
+
+    Args:
+        prepared: the input crop and its located silhouette.
+        rendered: N x N bool silhouette of the final de-rendered solid; recon: N x N x 3 uint8 over white.
+        limits: the thresholds.
+    """
     record = scores(prepared, rendered, recon)
     status, reasons = judge(record, limits)
     return {"status": status, "reasons": reasons, **record}

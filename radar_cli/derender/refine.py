@@ -15,6 +15,7 @@ import torch
 
 from radar_cli.config import CameraConfig
 from radar_cli.derender.fit_shape import ShapeFitConfig, fit_shape, outline_score
+from radar_cli.masks.refine import iou
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.raycast import cast_rays
 from radar_cli.sor.outline import mask_outline, outline
@@ -63,8 +64,7 @@ def silhouette_iou(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tenso
     with torch.no_grad():
         drawn = cast_rays(radius.float(), height.float(), pose.float(), mask.shape[0], camera, 1.0,
                           soft_outside=False).mask[0].numpy()
-    union = (drawn | mask).sum()
-    return float((drawn & mask).sum() / union) if union else 0.0
+    return iou(drawn, mask)
 
 
 def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarray, silhouette: np.ndarray | None,

@@ -88,12 +88,13 @@ def render_object(state: ObjectState, size: int, yaw_deg: float = 0.0, pitch_deg
 
 
 @torch.no_grad()
-def write_input_view(folder: Path, state: ObjectState, size: int) -> ViewRenderer:
+def write_input_view(folder: Path, state: ObjectState, size: int) -> tuple[ViewRenderer, np.ndarray]:
     """mask.png, mask_front.png, albedo_rendered.png, normal_rendered.png, recon.png, diffuse_rendered.png and
     specular_rendered.png at the input's size.
 
     Returns:
-        The input view's renderer (its rays serve other views of the same size and pose)."""
+        (the input view's renderer: its rays serve other views of the same size and pose; the reconstruction,
+        S x S x 3 uint8)."""
     view = ViewRenderer(state, size)
     hits = view.hits
     coverage = torch.where(hits.mask, torch.ones_like(hits.sil), hits.sil)  # 1 x S x S
@@ -106,11 +107,12 @@ def write_input_view(folder: Path, state: ObjectState, size: int) -> ViewRendere
     normals = torch.where(hits.mask[..., None], (hits.normal + 1) / 2, torch.zeros_like(hits.normal))
     write_picture(folder / NORMAL_RENDERED_FILE, to_uint8(normals[0].numpy()))
     shading = view.shading()
-    write_picture(folder / RECON_FILE, view.draw(shading))
+    recon = view.draw(shading)
+    write_picture(folder / RECON_FILE, recon)
     gamma, rho = state.render.gamma, state.rho[:, None, None, None]
     write_picture(folder / DIFFUSE_RENDERED_FILE, _on_object(hits, tone_map(shading.diffuse, gamma)))
     write_picture(folder / SPECULAR_RENDERED_FILE, _on_object(hits, tone_map(rho * shading.specular, gamma)))
-    return view
+    return view, recon
 
 
 def _on_object(hits: Hits, texture: torch.Tensor) -> np.ndarray:
@@ -192,12 +194,17 @@ def write_relit(folder: Path, view: ViewRenderer, envs: dict[str, np.ndarray]) -
 
 
 def write_renders(folder: Path, state: ObjectState, input_size: int, view_size: int, frames: int,
-                  envs: dict[str, np.ndarray]) -> None:
-    """Every render of one object; the turntable and relit views reuse the input view's rays at its size."""
-    input_view = write_input_view(folder, state, input_size)
+                  envs: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Every render of one object; the turntable and relit views reuse the input view's rays at its size.
+
+    Returns:
+        The input view's hard silhouette (S x S bool) and reconstruction (S x S x 3 uint8), for the quality
+        checks."""
+    input_view, recon = write_input_view(folder, state, input_size)
     write_picture(folder / MATERIAL_SPHERE_FILE, material_sphere(state, view_size))
     hits = input_view.hits if view_size == input_size else None
     view = ViewRenderer(texture_for_size(state, view_size), view_size, hits=hits)
     if frames > 0:
         write_turntable(folder, view, frames)
     write_relit(folder, view, envs)
+    return input_view.hits.mask[0].numpy(), recon

@@ -15,9 +15,11 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from radar_cli.derender.contact_sheet import NAME_W, TILE, LABEL_H, tile
+from radar_cli.derender.quality import psnr
 from radar_cli.derender.report import read_records
 from radar_cli.errors import InputError
 from radar_cli.fileio import read_image, write_image, write_json
+from radar_cli.masks.refine import iou
 from radar_cli.results import ALBEDO_RENDERED_FILE, INPUT_FILE, MASK_FILE, RECON_FILE, SILHOUETTE_FILE
 
 
@@ -28,12 +30,9 @@ def object_scores(folder: Path) -> dict[str, float]:
     drawn = read_image(folder / MASK_FILE, "L") > 127
     if drawn.shape != located.shape:
         raise InputError(f"{folder}: mask.png and silhouette.png differ in size")
-    union = (drawn | located).sum()
-    recon = read_image(folder / RECON_FILE, "RGB").astype(np.float64) / 255.0
-    image = read_image(folder / INPUT_FILE, "RGB").astype(np.float64) / 255.0
-    mse = float(((recon - image) ** 2)[located].mean()) if located.any() else math.nan
-    return {"iou": float((drawn & located).sum() / union) if union else 0.0,
-            "psnr": -10.0 * math.log10(max(mse, 1e-12))}
+    recon = read_image(folder / RECON_FILE, "RGB")
+    image = read_image(folder / INPUT_FILE, "RGB")
+    return {"iou": iou(drawn, located), "psnr": psnr(recon[located], image[located]) if located.any() else math.nan}
 
 
 def compare(a: Path, b: Path) -> dict[str, dict[str, dict[str, float]]]:
