@@ -8,6 +8,7 @@ import click
 
 from radar_cli.cli.derender import RESOLUTION
 from radar_cli.derender.inputs import DEFAULT_RESOLUTION, Resolution
+from radar_cli.derender.refine import REFINE_MODES
 from radar_cli.errors import InputError
 
 
@@ -96,7 +97,7 @@ def synth(size: int, n: int, workers: int, shading_size: int) -> None:
               help="radar derender --pitch.")
 @click.option("--resolution", type=RESOLUTION, default=str(DEFAULT_RESOLUTION), show_default=True,
               help="radar derender --resolution (the benchmark's photos are 1.6 x this side).")
-@click.option("--refine", type=click.Choice(["shape", "none"]), default="shape", show_default=True,
+@click.option("--refine", type=click.Choice(REFINE_MODES), default="full", show_default=True,
               help="radar derender --refine.")
 def derender(checkpoint: str | None, device: str, images: int, exports: int, batch_size: int, threads: int,
              workers: int, albedo: str, pitch: str, resolution: Resolution, refine: str) -> None:

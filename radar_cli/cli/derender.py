@@ -57,9 +57,10 @@ RESOLUTION = ResolutionType()
 @click.option("--pitch", type=click.Choice(PITCH_SOURCES), default="network", show_default=True,
               help="network: the shape network's pitch; search: the pitch whose re-rendering best matches the "
                    "photo and its silhouette, searched over the range (slower).")
-@click.option("--refine", type=click.Choice(REFINE_MODES), default="shape", show_default=True,
-              help="shape: fit each object's shape and pose to its silhouette and rim at the output resolution, "
-                   "then re-read lighting, material and albedo there; none: the network's prediction as it is.")
+@click.option("--refine", type=click.Choice(REFINE_MODES), default="full", show_default=True,
+              help="full: fit each object's shape and pose to its silhouette and rim at the output resolution, "
+                   "re-read lighting, material and albedo there, then fit the environment map to the photo's "
+                   "shading; shape: the same without the lighting fit; none: the network's prediction as it is.")
 @click.option("--views", type=click.IntRange(0, 360), default=8, show_default=True, help="Turntable frames.")
 @click.option("--resolution", type=RESOLUTION, default=str(DEFAULT_RESOLUTION), show_default=True,
               help="Side in pixels of the outputs (crop, renders, the frontal third of the maps): an integer, "

@@ -123,7 +123,7 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
                    export: ExportConfig = ExportConfig(), predictor: Predictor | None = None,
                    workers: int = 2, albedo: AlbedoSource = "divided",
                    pitch: PitchSource = "network", resolution: Resolution = DEFAULT_RESOLUTION,
-                   refine: RefineMode = "shape") -> dict:
+                   refine: RefineMode = "full") -> dict:
     """Measure de-rendering speed.
 
     Args:

@@ -13,6 +13,7 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig
+from radar_cli.derender.fit_light import LightFitConfig
 from radar_cli.derender.pitch_search import search_pitch
 from radar_cli.derender.refine import REFINE_MODES, RefineMode, RefineReport, refine_object
 from radar_cli.errors import CheckpointError, InputError
@@ -74,8 +75,9 @@ class Predictor:
             albedo, as the paper.
         pitch: `network`: f_S's pitch; `search`: derender.pitch_search where the silhouette is known (needs a
             RadarModel), f_S's elsewhere.
-        refine: `shape`: each object's shape and pose fitted at the output resolution, then f_L and f_A re-read
-            there (derender.refine; needs a RadarModel); `none`: the network's prediction as it is.
+        refine: `full`: each object's shape and pose fitted at the output resolution, f_L and f_A re-read
+            there, and the environment map fitted to the crop's shading (derender.refine; needs a RadarModel);
+            `shape`: the same without the lighting fit; `none`: the network's prediction as it is.
     """
 
     def __init__(self, model: Callable[[torch.Tensor], Decomposition], setup: ModelSetup, version: str,
@@ -165,8 +167,9 @@ class Predictor:
         if crop.shape[0] <= self.setup.image_size:
             return dec, RefineReport("off", "the output is at the network's size", crop.shape[0])
         batch = torch.from_numpy(image).permute(2, 0, 1)[None].to(self.device, torch.float32) / 255.0
+        light = LightFitConfig() if self.refine == "full" else None
         refined, report = refine_object(self.model, batch, dec.to(self.device), crop, silhouette,
-                                        self.setup.camera)
+                                        self.setup.camera, light=light)
         return (dec if refined is None else refined.to("cpu")), report
 
     def _search_pitch(self, batch: torch.Tensor, silhouettes: list[np.ndarray | None],

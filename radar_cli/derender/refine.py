@@ -1,7 +1,9 @@
-"""Per-object refinement after the network (`radar derender --refine shape`, the default): the shape and pose
-fitted to the silhouette and the rim at the crop's resolution (derender.fit_shape), then the lighting, material
-and albedo networks re-read at the fitted shape. A fit that fails, or draws the outline worse than the network's
-prediction, falls back to the network's and says why (material.json `refine`, summary.csv)."""
+"""Per-object refinement after the network (`radar derender --refine full`, the default): the shape and pose
+fitted to the silhouette and the rim at the crop's resolution (derender.fit_shape), the lighting, material and
+albedo networks re-read at the fitted shape, then the environment map fitted to the photograph's shading there
+(derender.fit_light). A shape fit that fails, or draws the outline worse than the network's prediction, falls back
+to the network's and says why (material.json `refine`, summary.csv); a lighting fit that draws the texture no
+better than the map it started from keeps the network's map. `--refine shape` stops after the re-reading."""
 
 from __future__ import annotations
 
@@ -14,14 +16,15 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig
+from radar_cli.derender.fit_light import LightFitConfig, fit_environment
 from radar_cli.derender.fit_shape import ShapeFitConfig, fit_shape, outline_score
 from radar_cli.masks.refine import iou
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.raycast import cast_rays
 from radar_cli.sor.outline import mask_outline, outline
 
-RefineMode = Literal["shape", "none"]
-REFINE_MODES: tuple[RefineMode, ...] = ("shape", "none")
+RefineMode = Literal["full", "shape", "none"]
+REFINE_MODES: tuple[RefineMode, ...] = ("full", "shape", "none")
 FIT_ERRORS = (ValueError, RuntimeError, FloatingPointError)
 
 
@@ -37,6 +40,10 @@ class RefineReport:
         outline_px: mean distance between the drawn and the located outline (px at `resolution`), refined /
             network.
         iou: silhouette IoU against the located one at `resolution`, refined / network.
+        light: `fitted` (the environment map fitted to the shading), `kept` (the network's map: the fit drew
+            the texture no better, or too few texels were usable) or '' (not run: `--refine shape`, or no shape
+            fit).
+        light_rmse: the paints' model against the unwrapped texture (display levels), fitted / network map.
         seconds: time the fit took.
     """
 
@@ -46,6 +53,8 @@ class RefineReport:
     pitch_cue: str = ""
     outline_px: tuple[float, float] = (float("nan"), float("nan"))
     iou: tuple[float, float] = (float("nan"), float("nan"))
+    light: str = ""
+    light_rmse: tuple[float, float] = (float("nan"), float("nan"))
     seconds: float = 0.0
 
     def record(self) -> dict:
@@ -55,7 +64,9 @@ class RefineReport:
         return {"status": self.status, "reason": self.reason, "resolution": self.resolution,
                 "pitch_cue": self.pitch_cue, "outline_px": {"refined": clean(self.outline_px[0]),
                                                             "network": clean(self.outline_px[1])},
-                "silhouette_iou": {"refined": clean(self.iou[0]), "network": clean(self.iou[1])}}
+                "silhouette_iou": {"refined": clean(self.iou[0]), "network": clean(self.iou[1])},
+                "light": self.light, "light_rmse": {"fitted": clean(self.light_rmse[0]),
+                                                    "network": clean(self.light_rmse[1])}}
 
 
 def silhouette_iou(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, mask: np.ndarray,
@@ -68,8 +79,8 @@ def silhouette_iou(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tenso
 
 
 def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarray, silhouette: np.ndarray | None,
-                  camera: CameraConfig, config: ShapeFitConfig = ShapeFitConfig()) -> tuple[Decomposition | None,
-                                                                                             RefineReport]:
+                  camera: CameraConfig, config: ShapeFitConfig = ShapeFitConfig(),
+                  light: LightFitConfig | None = LightFitConfig()) -> tuple[Decomposition | None, RefineReport]:
     """Refine one object's prediction.
 
     Args:
@@ -77,7 +88,8 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
         image: 1 x 3 x S x S network input in [0, 1]. dec: its Decomposition (batch of one, CPU).
         crop: N x N x 3 uint8 crop at the output resolution; silhouette: N x N bool located silhouette (None:
             nothing to fit, the network's prediction is kept).
-        camera: the fixed camera. config: the fit's settings.
+        camera: the fixed camera. config, light: the shape and the lighting fits' settings (light None: no
+            lighting fit, the networks' re-reading is kept).
 
     Returns:
         (the refined Decomposition with config.rows profile rows, or None to keep `dec`; the report).
@@ -99,7 +111,7 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
                                  outline_px=(float("nan"), network_px), iou=(float("nan"), network_iou),
                                  seconds=time.perf_counter() - start)
     report = RefineReport("refined", "", size, fit.pitch_cue, (fit.outline_error, network_px),
-                          (refined_iou, network_iou), time.perf_counter() - start)
+                          (refined_iou, network_iou), seconds=time.perf_counter() - start)
     if not refined_iou >= network_iou:
         return None, dataclasses.replace(report, status="fallback",
                                         reason=f"the fit drew the silhouette worse (IoU {refined_iou:.3f} "
@@ -107,4 +119,24 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
     device = image.device
     with torch.no_grad():
         refined = model.read_appearance(image, fit.radius.to(device), fit.height.to(device), fit.pose.to(device))
-    return refined.detach(), report
+    refined = refined.detach()
+    if light is not None:
+        refined, report = _fit_light(refined, dec.env, crop, silhouette, camera, light, report)
+    return refined, dataclasses.replace(report, seconds=time.perf_counter() - start)
+
+
+def _fit_light(refined: Decomposition, network_env: torch.Tensor, crop: np.ndarray, silhouette: np.ndarray,
+               camera: CameraConfig, config: LightFitConfig, report: RefineReport) -> tuple[Decomposition,
+                                                                                             RefineReport]:
+    """`refined` with its environment map fitted to the crop's shading (derender.fit_light), starting from the
+    network's first reading `network_env` (1 x He x We), or with that map where the fit does not draw the texture
+    better."""
+    with torch.no_grad():
+        fit = fit_environment(crop, silhouette, refined.radius, refined.height, refined.pose, network_env,
+                              float(refined.alpha[0]), float(refined.rho[0]), camera, config)
+    if fit is None:
+        return dataclasses.replace(refined, env=network_env), dataclasses.replace(report, light="kept")
+    report = dataclasses.replace(report, light_rmse=fit.rmse)
+    if not fit.rmse[0] < fit.rmse[1]:
+        return dataclasses.replace(refined, env=network_env), dataclasses.replace(report, light="kept")
+    return dataclasses.replace(refined, env=fit.env), dataclasses.replace(report, light="fitted")

@@ -1,0 +1,204 @@
+"""The environment map refined against the photograph's shading at the fitted shape (radar's addition, step 2 of
+`radar derender --refine shape`; docs/refinement.md).
+
+The photograph's frontal texture is unwrapped at the fitted shape onto a texel grid. Everything the shading
+cannot tell from the albedo is pinned by one assumption: a vessel is painted in a few colours. The texture
+divided by the starting lighting is clustered into those paints (k-means in display colour); a texel far from
+its paint's centre (a thin line, an anti-aliased edge) is left out. Then, alternately, each paint's linear albedo
+follows in closed form from the lighting (least squares over its texels) and the lighting from the paints (a
+regularised least-squares solve for a coarse environment map: the image is linear in it), with shininess and
+specular albedo held at the network's. The map keeps the starting map's mean, since the albedo's brightness and
+the light's cannot be told apart.
+
+Only the environment map is refined. Shininess and specular albedo are not: with the map unknown, a sharper light
+and a lower shininess, or a brighter light in the highlight's direction and a lower specular albedo, draw the
+same photograph (docs/refinement.md measures it).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+import torch
+import torch.nn.functional as F
+
+from radar_cli.config import CameraConfig
+from radar_cli.render.lighting import GAMMA, env_directions
+from radar_cli.render.texture import unwrap
+from radar_cli.sor.surface import surface_grid
+
+
+@dataclass(frozen=True)
+class LightFitConfig:
+    """How the environment map is fitted (chosen on `radar synth --size 512` seeds 5 and 7; docs/refinement.md).
+
+    Attributes:
+        texels: side of the frontal texel grid the photograph is unwrapped onto.
+        coarse: (rows, columns) of the fitted map, upsampled bilinearly to the model's map.
+        paints: k-means clusters of the divided albedo.
+        min_share: a paint covering less than this share of the usable texels is left out.
+        max_distance: texels further than this from their paint's centre (display colour, 0..1) are left out.
+        min_facing: texels whose normal faces the camera less than this (cosine) are left out.
+        coverage: texels less covered than this by the located silhouette are left out.
+        rounds: alternations of paints and lighting.
+        smooth: weight of the map's smoothness (squared differences of neighbouring coarse texels).
+        ridge: weight of the pull towards the starting map (relative to `smooth`).
+    """
+
+    texels: int = 64
+    coarse: tuple[int, int] = (8, 24)
+    paints: int = 6
+    min_share: float = 0.03
+    max_distance: float = 0.08
+    min_facing: float = 0.2
+    coverage: float = 0.9
+    rounds: int = 6
+    smooth: float = 0.3
+    ridge: float = 1.0
+
+
+@dataclass(frozen=True)
+class LightFit:
+    """A fitted environment map and how well it draws the photograph.
+
+    Attributes:
+        env: 1 x He x We environment map (the starting map's size and mean).
+        rmse: (fitted, start) root-mean-square error of the paints' model against the texture on the used
+            texels, display levels 0..1.
+        texels: texels used.
+    """
+
+    env: torch.Tensor
+    rmse: tuple[float, float]
+    texels: int
+
+
+def upsampler(coarse: tuple[int, int], size: tuple[int, int]) -> torch.Tensor:
+    """The bilinear upsampling from a coarse map to a full one as a matrix: (He*We) x (hc*wc), float64."""
+    n = coarse[0] * coarse[1]
+    basis = np.eye(n, dtype=np.float32).reshape(n, coarse[0], coarse[1])
+    cols = [cv2.resize(b, (size[1], size[0]), interpolation=cv2.INTER_LINEAR).reshape(-1) for b in basis]
+    return torch.from_numpy(np.stack(cols, axis=1).astype(np.float64))
+
+
+def smoothness(coarse: tuple[int, int]) -> torch.Tensor:
+    """D^T D of the coarse map's neighbour differences (across rows, and across columns with the azimuth
+    wrapping round): (hc*wc) x (hc*wc), float64."""
+    rows, cols = coarse
+    index = torch.arange(rows * cols).reshape(rows, cols)
+    pairs = [(index[:, :], index.roll(-1, dims=1)), (index[:-1], index[1:])]
+    a = torch.cat([p[0].reshape(-1) for p in pairs])
+    b = torch.cat([p[1].reshape(-1) for p in pairs])
+    diff = torch.zeros(a.numel(), rows * cols, dtype=torch.float64)
+    diff[torch.arange(a.numel()), a] = 1.0
+    diff[torch.arange(a.numel()), b] = -1.0
+    return diff.T @ diff
+
+
+def light_transport(normals: torch.Tensor, view: torch.Tensor, alpha: float, size: tuple[int, int]
+                    ) -> tuple[torch.Tensor, torch.Tensor]:
+    """The diffuse and specular factors of each texel per environment texel (render.lighting's Phong, as
+    matrices: I_d = Kd @ env, I_s = Ks @ env).
+
+    Args:
+        normals, view: n x 3 unit vectors (camera frame), float64. alpha: shininess. size: (He, We).
+
+    Returns:
+        (Kd, Ks), each n x (He*We).
+    """
+    dirs, solid = env_directions(*size, device=normals.device, dtype=normals.dtype)
+    cos_light = normals @ dirs.T  # n x E
+    mirror = 2 * (normals * view).sum(-1, keepdim=True) * normals - view
+    cos_mirror = (mirror @ dirs.T).clamp_min(0.0) * (cos_light > 0)
+    lobe = torch.exp((alpha * torch.log(cos_mirror.clamp_min(1e-30))).clamp_min(-60.0))
+    return cos_light.clamp_min(0.0) * solid, (alpha + 1) / (2 * math.pi) * lobe * solid
+
+
+def paint_labels(albedo: np.ndarray, config: LightFitConfig) -> np.ndarray:
+    """Cluster display-space albedo colours (n x 3, 0..1) into paints: n labels, -1 where left out."""
+    pixels = np.ascontiguousarray(albedo, dtype=np.float32)
+    k = min(config.paints, len(pixels))
+    cv2.setRNGSeed(0)
+    criteria = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 30, 1e-3)
+    _, labels, centres = cv2.kmeans(pixels, k, None, criteria, 3, cv2.KMEANS_PP_CENTERS)
+    labels = labels[:, 0]
+    distance = np.linalg.norm(pixels - centres[labels], axis=1)
+    share = np.bincount(labels, minlength=k) / len(labels)
+    keep = (share[labels] >= config.min_share) & (distance < config.max_distance)
+    return np.where(keep, labels, -1)
+
+
+def fit_environment(crop: np.ndarray, silhouette: np.ndarray, radius: torch.Tensor, height: torch.Tensor,
+                    pose: torch.Tensor, env: torch.Tensor, alpha: float, rho: float, camera: CameraConfig,
+                    config: LightFitConfig = LightFitConfig()) -> LightFit | None:
+    """Fit the environment map to the photograph's shading at a fitted shape.
+
+    Args:
+        crop: N x N x 3 uint8 crop; silhouette: N x N bool located silhouette.
+        radius: 1 x L; height: 1; pose: 1 x 4 (the fitted shape and pose).
+        env: 1 x He x We starting map. alpha, rho: shininess and specular albedo, held.
+        camera: the fixed camera.
+
+    Returns:
+        The fit, or None when too few texels are usable (under 5% of the grid).
+    """
+    g = config.texels
+    dtype = torch.float64
+    geo = (radius.double().cpu(), height.double().cpu(), pose.double().cpu())
+    image = torch.from_numpy(np.ascontiguousarray(crop)).permute(2, 0, 1)[None].to(dtype) / 255.0
+    cover = torch.from_numpy(silhouette.astype(np.float64))[None, None]
+    texture = unwrap(*geo, torch.cat([image, cover], 1), (g, g), camera)[0].reshape(4, -1)  # 4 x g*g
+    grid = surface_grid(*geo, g, g, camera)
+    normals, view = grid.normals[0].reshape(-1, 3), grid.view[0].reshape(-1, 3)
+    usable = (texture[3] > config.coverage) & ((normals * view).sum(-1) > config.min_facing)
+    if int(usable.sum()) < 0.05 * g * g:
+        return None
+    shown = texture[:3, usable]  # 3 x n display
+    linear = shown ** GAMMA
+    size = tuple(env.shape[-2:])
+    up = upsampler(config.coarse, size)  # E x c
+    kd_full, ks_full = light_transport(normals[usable], view[usable], alpha, size)
+    kd, ks = kd_full @ up, ks_full @ up  # n x c
+    start = env[0].double().cpu()
+    coarse_start = F.adaptive_avg_pool2d(start[None, None], config.coarse).reshape(-1)
+    mean = float(coarse_start.mean())
+
+    diffuse, specular = kd_full @ start.reshape(-1), ks_full @ start.reshape(-1)
+    divided = ((linear - rho * specular) / diffuse.clamp_min(1e-6)).clamp(0.0, 1.0) ** (1 / GAMMA)
+    labels = torch.from_numpy(paint_labels(divided.T.numpy(), config))
+    keep = labels >= 0
+    if int(keep.sum()) < 0.05 * g * g:
+        return None
+    linear, shown, kd, ks = linear[:, keep], shown[:, keep], kd[keep], ks[keep]
+    _, paint = torch.unique(labels[keep], return_inverse=True)  # n paint indices 0..P-1
+    n_paints = int(paint.max()) + 1
+    smooth = smoothness(config.coarse)
+    eye = torch.eye(smooth.shape[0], dtype=dtype)
+
+    def paints(e: torch.Tensor) -> torch.Tensor:
+        """3 x n: each texel's paint albedo (least squares over the paint's texels), linear."""
+        d, s = kd @ e, ks @ e
+        num = torch.zeros(3, n_paints, dtype=dtype).index_add_(1, paint, d * (linear - rho * s))
+        den = torch.zeros(n_paints, dtype=dtype).index_add_(0, paint, d * d)
+        return (num / den.clamp_min(1e-12)).clamp_min(1e-3)[:, paint]
+
+    def rmse(e: torch.Tensor, albedo: torch.Tensor) -> float:
+        drawn = (albedo * (kd @ e) + rho * (ks @ e)).clamp_min(1e-6) ** (1 / GAMMA)
+        return float(((drawn - shown) ** 2).mean().sqrt())
+
+    e = coarse_start.clone()
+    start_rmse = rmse(e, paints(e))
+    for _ in range(config.rounds):
+        albedo = paints(e)
+        system = torch.cat([albedo[c][:, None] * kd + rho * ks for c in range(3)])  # 3n x c
+        weight = config.smooth * float((system * system).sum()) / (10 * system.shape[1])
+        lhs = system.T @ system + weight * (smooth + config.ridge * eye)
+        rhs = system.T @ linear.reshape(-1) + weight * config.ridge * coarse_start
+        e = torch.linalg.solve(lhs, rhs).clamp_min(0.0)
+        e = e * (mean / max(float(e.mean()), 1e-12))
+    fitted = (up @ e).reshape(1, *size).clamp_min(0.0)
+    fitted = fitted * (float(start.mean()) / max(float(fitted.mean()), 1e-12))
+    return LightFit(fitted.to(env.dtype).to(env.device), (rmse(e, paints(e)), start_rmse), int(keep.sum()))
