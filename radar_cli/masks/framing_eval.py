@@ -86,21 +86,24 @@ def located_iou(variant: Variant) -> tuple[float, float]:
     return iou(found.silhouette | found.appendages, truth), iou(found.silhouette, truth)
 
 
-def evaluate(sources: list[tuple[str, np.ndarray, np.ndarray]], seed: int,
-             synthetic: set[str]) -> tuple[Results, list[tuple[str, Variant]]]:
-    """Locate every variant of every source; pasted vases also get handles."""
-    rng = np.random.default_rng(seed + 2)
+def evaluate(sources: list[tuple[str, np.ndarray, np.ndarray]], seed: int, synthetic: set[str],
+             kinds: tuple[str, ...] = (*KINDS, "handles")) -> tuple[Results, list[tuple[str, Variant]]]:
+    """Locate every variant of every source (of `kinds` only; the others are drawn all the same, so a variant
+    is the same whichever kinds are located); pasted vases also get handles. Each source draws its variants
+    from its own generator: they do not change when another source's reference does."""
     results, items = Results(), []
     for n, (name, photo, truth) in enumerate(sources):
+        rng = np.random.default_rng((seed + 2, n))
         for k, kind in enumerate(KINDS):
             variant = make_variant(kind, photo, truth, rng, index=n + k)
-            whole, _ = located_iou(variant)
-            results.add(kind=kind, source=name, iou=whole)
-            items.append((name, variant))
+            if kind in kinds:
+                results.add(kind=kind, source=name, iou=located_iou(variant)[0])
+                items.append((name, variant))
         if name in synthetic:
             handled = Variant("handles", with_handles(photo, truth, rng)[0], truth)
-            results.add(kind="handles", source=name, iou=located_iou(handled)[1])
-            items.append((name, handled))
+            if "handles" in kinds:
+                results.add(kind="handles", source=name, iou=located_iou(handled)[1])
+                items.append((name, handled))
     return results, items
 
 
@@ -232,14 +235,23 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--no-status", action="store_true", help="skip de-rendering (IoU table only)")
     parser.add_argument("--sheet", type=Path, help="also write a PNG of the worst-located variants")
+    parser.add_argument("--kinds", default=",".join((*KINDS, "handles")),
+                        help="comma-separated variant kinds to locate (default: all)")
+    parser.add_argument("--worst", type=int, default=0, help="also list this many worst-located variants")
     args = parser.parse_args()
+    kinds = tuple(args.kinds.split(","))
+    unknown = set(kinds) - {*KINDS, "handles"}
+    if unknown:
+        parser.error(f"unknown kinds {', '.join(sorted(unknown))} (use {', '.join((*KINDS, 'handles'))})")
     cv2.setNumThreads(1)
     t0 = time.time()
     real = real_sources(args.real) if args.real.is_dir() else []
     synth = synthetic_sources(args.synthetic, args.seed) if args.synthetic else []
-    results, items = evaluate(real + synth, args.seed, {name for name, _, _ in synth})
+    results, items = evaluate(real + synth, args.seed, {name for name, _, _ in synth}, kinds)
     print(f"{len(real)} real photos, {len(synth)} pasted vases, {len(results.rows)} variants")
     print(iou_table(results))
+    for r in sorted(results.rows, key=lambda r: r["iou"])[: args.worst]:
+        print(f"  {r['kind']:8s} {r['source']:28s} IoU {r['iou']:.3f}")
     if args.sheet:
         worst_sheet(results, items, args.sheet)
     if not args.no_status:

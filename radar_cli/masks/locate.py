@@ -7,12 +7,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 
 from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
-from radar_cli.masks.appendages import Core, symmetric_core
-from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale
+from radar_cli.masks.appendages import Core, find_axis, symmetric_core
+from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fit_backdrop
 from radar_cli.masks.pipeline import Refined, Settings, check_photo, refine_detection, refine_window
 from radar_cli.masks.refine import main_component
 
@@ -22,6 +23,10 @@ STAND_STEP = 0.08  # ... whose width differs from the vessel's foot above it by 
 STAND_TOLERANCE = 0.015  # straight sides: the stand's edges move less than this fraction of the window per row
 STAND_COLOUR_STEP = 30.0  # ... and whose mean colour is this far (RGB levels) from the vessel's above it ...
 STAND_BIG_STEP = 0.25  # ... unless the width step is this large
+GAP_RING = (0.02, 0.06)  # the backdrop around the object is modelled from this ring (fraction of the window)
+GAP_DISTANCE = 3.0  # object pixels this close to the backdrop model (in its noise units) may be backdrop ...
+GAP_MIN = 0.002  # ... seen through the object where they form a patch of at least this share of it ...
+GAP_DEPTH = 0.08  # ... that comes this close (fraction of the object's width) to its outline ...
 
 
 @dataclass(frozen=True)
@@ -135,6 +140,54 @@ def remove_stand(mask: np.ndarray, image: np.ndarray) -> tuple[np.ndarray, bool]
     return main_component(mask & ~stand), True
 
 
+def open_gaps(mask: np.ndarray, image: np.ndarray) -> np.ndarray:
+    """Take out of a located object the backdrop seen between a handle and the body: patches of the object
+    whose colour the backdrop around it explains, near its outline and beside the vessel's axis (a patch of
+    the body's own decoration that matches the backdrop is rarely all three). The located mask has them filled
+    (GrabCut closes a thin gap); open, they let the handle part from the body.
+
+    Args:
+        mask: n x n bool located object. image: n x n x 3 uint8, the pixels it was located in.
+
+    Returns:
+        n x n bool mask without the gaps (its largest part).
+    """
+    cols = np.nonzero(mask.any(0))[0]
+    if len(cols) < 10:
+        return mask
+    n = mask.shape[0]
+    near = cv2.dilate(mask.astype(np.uint8), np.ones((3, 3), np.uint8), iterations=max(1, int(GAP_RING[0] * n)))
+    far = cv2.dilate(mask.astype(np.uint8), np.ones((3, 3), np.uint8), iterations=max(2, int(GAP_RING[1] * n)))
+    ring = (far > 0) & ~(near > 0)
+    if ring.sum() < 50:
+        return mask
+    pixels = image.astype(np.float32)
+    model, noise = fit_backdrop(pixels, ring)
+    dist = np.sqrt((((pixels - model) / noise) ** 2).sum(axis=2))
+    candidate = (mask & (dist < GAP_DISTANCE)).astype(np.uint8)
+    count, labels, stats, _ = cv2.connectedComponentsWithStats(candidate, connectivity=4)
+    if count <= 1:
+        return mask
+    depth = cv2.distanceTransform(np.pad(mask, 1).astype(np.uint8), cv2.DIST_L2, 3)[1:-1, 1:-1]
+    tilt, axis = find_axis(mask)
+    ys, xs = np.nonzero(mask)
+    turn = cv2.getRotationMatrix2D((float(xs.mean()), float(ys.mean())), tilt, 1.0)  # as find_axis turns it
+    width = cols.max() - cols.min() + 1
+    gaps = np.zeros_like(mask)
+    for i in range(1, count):
+        if stats[i, cv2.CC_STAT_AREA] < GAP_MIN * mask.sum():
+            continue
+        part = labels == i
+        if depth[part].min() > GAP_DEPTH * width:
+            continue
+        py, px = np.nonzero(part)
+        upright_x = turn[0, 0] * px + turn[0, 1] * py + turn[0, 2]
+        if upright_x.min() <= axis + 0.5 <= upright_x.max() + 1:
+            continue
+        gaps |= part
+    return main_component(mask & ~gaps) if gaps.any() else mask
+
+
 def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: float = crops.DEFAULT_MARGIN) -> Located:
     """Locate the vessel of a photo and cut its square crop around the symmetric core.
 
@@ -159,7 +212,7 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
             raise InputError(f"{name}: no object stands out from the backdrop; crop it square or use --crop none")
         found = detections[0]
         refined = refine_detection(rgb, found, settings)
-    mask, stand = remove_stand(refined.mask, refined.image)
+    mask, stand = remove_stand(open_gaps(refined.mask, refined.image), refined.image)
     split: Core = symmetric_core(mask)
     final, image, core = refined.framed(rgb, split.core, settings, fill=255)  # beyond the frame: white
     _, _, whole = refined.framed(rgb, mask, settings, box_mask=split.core)

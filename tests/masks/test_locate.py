@@ -9,7 +9,7 @@ import pytest
 from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
 from radar_cli.masks.appendages import symmetric_core
-from radar_cli.masks.locate import locate_object, remove_stand
+from radar_cli.masks.locate import locate_object, open_gaps, remove_stand
 from radar_cli.masks.refine import iou
 from radar_cli.masks.synthetic import composite, render_vases
 from radar_cli.masks.variants import KINDS, Variant, make_variant, with_handles
@@ -84,6 +84,33 @@ def test_handles_are_left_out_of_the_core(sources: list) -> None:
         core_truth = crops.cut(truth.astype(np.float32), found.box, SIZE, fill=0) > 0.5
         assert iou(found.silhouette, core_truth) >= 0.9
         assert found.appendage_fraction > 0.03
+
+
+def _hugging_handles(gap_colour: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A 200 x 200 vessel with two loop handles that hug the body over half its height, the thin gap between
+    them filled in the located mask (as GrabCut closes it): (mask, image, the body's own silhouette)."""
+    yy, xx = np.mgrid[0:200, 0:200]
+    body = ((xx - 100) / 45.0) ** 2 + ((yy - 100) / 80.0) ** 2 < 1
+    loop = ((xx - 100) / 56.0) ** 2 + ((yy - 95) / 45.0) ** 2
+    handles = (loop < 1) & (loop > 0.8) & (yy > 60) & (yy < 130)
+    filled = (loop < 1) & (yy > 60) & (yy < 130)
+    image = np.full((200, 200, 3), 200, np.uint8)  # the backdrop
+    image[filled] = gap_colour
+    image[body | handles] = (90, 50, 30)
+    return body | filled, image, body
+
+
+def test_backdrop_between_a_hugging_handle_and_the_body_is_opened() -> None:
+    mask, image, body = _hugging_handles(200)
+    assert iou(symmetric_core(mask).core, body) < 0.93  # filled, the handles widen the core over a long span
+    opened = open_gaps(mask, image)
+    assert not (opened & ~mask).any() and opened[body].all()
+    assert iou(symmetric_core(opened).core, body) >= 0.97
+    mask, image, _ = _hugging_handles(120)  # no backdrop between them: nothing is opened
+    assert (open_gaps(mask, image) == mask).all()
+    decorated = image.copy()
+    decorated[90:110, 90:110] = 200  # a backdrop-coloured patch on the axis is the vessel's own
+    assert open_gaps(body, decorated)[90:110, 90:110].all()
 
 
 def test_a_plain_solid_has_no_appendages(sources: list) -> None:
