@@ -70,3 +70,34 @@ def test_no_silhouette_keeps_the_network():
     start = _perturbed(params, 0.0, 1.0)
     kept, report = refine_object(Appearance(), torch.zeros(1, 3, 64, 64), start, image, None, CameraConfig())
     assert kept is None and report.status == "fallback" and "silhouette" in report.reason
+
+
+def test_lighting_fit_runs_after_the_shape_and_repeats_bit_for_bit():
+    """--refine full: the environment map is fitted (or the network's kept, and said so); the same object gives the
+    same tensors again, on one thread or two (the export workers run it on any)."""
+    image, mask, params = _sample(0)
+    start = _perturbed(params, 2.0, 1.05)
+    runs = []
+    threads = torch.get_num_threads()
+    try:
+        for n in (1, 2):
+            torch.set_num_threads(n)
+            runs.append(refine_object(Appearance(), torch.zeros(1, 3, 64, 64), start, image, mask, CameraConfig()))
+    finally:
+        torch.set_num_threads(threads)
+    (first, report), (second, _) = runs
+    assert report.light in ("fitted", "kept") and report.record()["light"] == report.light
+    if report.light == "fitted":
+        assert report.light_rmse[0] < report.light_rmse[1]
+    else:
+        assert torch.equal(first.env, start.env)
+    for a, b in zip(first.as_tuple(), second.as_tuple()):
+        assert torch.equal(a, b)
+
+
+def test_shape_only_keeps_the_re_read_lighting():
+    image, mask, params = _sample(0)
+    start = _perturbed(params, 2.0, 1.05)
+    refined, report = refine_object(Appearance(), torch.zeros(1, 3, 64, 64), start, image, mask, CameraConfig(),
+                                    light=None)
+    assert report.light == "" and torch.equal(refined.env, torch.ones(1, 4, 12))
