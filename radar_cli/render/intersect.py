@@ -112,7 +112,7 @@ def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_
     Returns:
         Found (all M).
     """
-    m, n_rows = origin.shape[0], rows.shape[1]
+    n_rows = rows.shape[1]
     s_c = -(origin * direction).sum(-1)
     oc = origin + s_c[:, None] * direction
     dx, dy, dz = direction.unbind(-1)
