@@ -126,11 +126,16 @@ def spoilt_input(kind: str, variant: Variant, size: int):
 
         prepared = Prepared(crops.cut(rgb, box, size), box, rgb.shape[1::-1], silhouette=frame,
                             cut_edges=("top", "bottom", "left", "right"), frame_coverage=1.0)
-    else:
-        prepared = located_input(variant.image, size, "shifted")
+    else:  # at both sides, as a locator that found it would give it
+        prepared = located_input(variant.image, size, "shifted", backdrop="keep")
         cols = np.nonzero(prepared.silhouette.any(0))[0]
-        moved = np.roll(prepared.silhouette, max(1, (cols.max() - cols.min()) // 5), axis=1)
-        prepared = dataclasses.replace(prepared, silhouette=moved, image=white_backdrop(prepared.image, moved))
+        shift = max(1, (cols.max() - cols.min()) // 5)
+        moved = np.roll(prepared.silhouette, shift, axis=1)
+        photo_moved = np.roll(prepared.photo_silhouette, round(shift * prepared.side / size), axis=1)
+        prepared = dataclasses.replace(
+            prepared, silhouette=moved, image=white_backdrop(prepared.image, moved),
+            photo_silhouette=photo_moved, photo_image=white_backdrop(prepared.photo_scene, photo_moved),
+            backdrop="white")
     truth = crops.cut(variant.truth.astype(np.float32), prepared.crop, size, fill=0) > 0.5
     return prepared, iou(prepared.silhouette, truth)
 
@@ -174,7 +179,7 @@ def judge_status(results: Results, items: list[tuple[str, Variant]], batch: int 
         for j, i in enumerate(keys):
             state = ObjectState.from_decomposition(dec.select(j), predictor.setup.render, predictor.setup.camera)
             quality = assess(prepared[i], state)
-            results.rows[i].update(status=quality["status"], reasons=quality["reasons"])
+            results.rows[i].update(status=quality["status"], reasons=quality["reasons"], quality=quality)
 
 
 def iou_table(results: Results) -> str:
