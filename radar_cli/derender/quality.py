@@ -39,9 +39,9 @@ class QualityLimits:
     """Reconstruction PSNR (dB) inside the silhouette below this: review."""
     review_cut_edges: int = 3
     """An object running into this many photo edges or more: review (the photo may not show all of it)."""
-    review_support: float = 0.0
-    """Share of the silhouette's outline on an edge of the photo below this: review (the silhouette does not
-    sit on the object)."""
+    review_support: float = 0.65
+    """Share of the silhouette's outline on an edge of the photo (`outline_support`) below this: review (the
+    silhouette does not sit on the object's edge)."""
 
 
 def psnr(a: np.ndarray, b: np.ndarray) -> float:

@@ -205,6 +205,17 @@ def status_table(results: Results) -> str:
     return "\n".join(lines)
 
 
+def support_table(results: Results) -> str:
+    """Markdown: the outline support of the judged items per variant kind (None where not measurable)."""
+    lines = ["| variant | n | min support | mean support | max support |", "|---|---|---|---|---|"]
+    for kind in (*KINDS, "handles", *BROKEN):
+        s = np.array([r["quality"]["outline_support"] for r in results.rows if r["kind"] == kind
+                      and r.get("quality") and r["quality"].get("outline_support") is not None])
+        if len(s):
+            lines.append(f"| {kind} | {len(s)} | {s.min():.3f} | {s.mean():.3f} | {s.max():.3f} |")
+    return "\n".join(lines)
+
+
 def overlay(found_image: np.ndarray, core: np.ndarray, appendages: np.ndarray) -> np.ndarray:
     """The crop with its core tinted red and its appendages blue (S x S x 3 uint8)."""
     out = found_image.astype(np.float32)
@@ -263,6 +274,7 @@ def main() -> None:
         judge_status(results, items)
         print(status_table(results))
         print(iou_table(Results([r for r in results.rows if r["kind"] in BROKEN])))
+        print(support_table(results))
         for r in results.rows:
             if r["iou"] < 0.8 and r.get("status") == "ok" or r["iou"] > 0.95 and r.get("status") != "ok":
                 print(f"  {r['kind']:8s} {r['source']:28s} IoU {r['iou']:.3f} {r.get('status')}: "
