@@ -24,6 +24,9 @@ def reach(side: int) -> float:
 def outline_normals(silhouette: np.ndarray, smooth: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The outline pixels of an H x W bool silhouette (its pixels with a 4-neighbour outside it) and their
     outward unit normals: (ys, xs, normals), normals K x 2 as (dx, dy)."""
+    if silhouette.all() or not silhouette.any():  # no outline (and no distance to measure)
+        empty = np.zeros(0, int)
+        return empty, empty, np.zeros((0, 2))
     sil = silhouette.astype(np.uint8)
     inside = cv2.distanceTransform(sil, cv2.DIST_L2, 3)
     outside = cv2.distanceTransform(1 - sil, cv2.DIST_L2, 3)
