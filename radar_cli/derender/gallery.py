@@ -37,7 +37,8 @@ VIEWER_ENV_SIZE = (64, 128)  # He x We of the built-in environments written for 
 VIEWER_ENV_UPSAMPLE = 4  # an object's He x We map is enlarged (nearest) so its width divides by 4
 MAX_META_BYTES = 1024 * 1024  # meta.json beside an input is untrusted: refuse larger files
 STATUS_UNKNOWN = "unknown"  # objects without a quality record
-SCORE_KEYS = ("silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction", "frame_coverage")
+SCORE_KEYS = ("silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction", "outline_support",
+              "frame_coverage")
 PAGE_FILES = ("index.css", "gallery.js", "model-viewer-umd.min.js", "LICENSE-model-viewer.txt",
               "THIRD_PARTY_LICENSES.txt")
 

@@ -86,6 +86,8 @@ class Prepared:
             backdrop treated as `image`'s); `image` itself when N = S (the default).
         photo_silhouette: N x N bool, `silhouette` at N (None where that is None).
         appendages: N x N bool, the located object's pixels left out of the core; None if not split.
+        photo_scene: N x N x 3 uint8, the window at N as photographed (the backdrop not replaced; cut-outs on
+            white); `photo_image` before `backdrop` replaced it.
         cut_edges: the photo edges the located object runs into (`top`, `bottom`, `left`, `right`).
         frame_coverage: share of the photo the located object covers; None if not located.
     """
@@ -100,11 +102,14 @@ class Prepared:
     appendages: np.ndarray | None = None
     cut_edges: tuple[str, ...] = ()
     frame_coverage: float | None = None
+    photo_scene: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.photo_image is None:  # frozen: the network's crop is the output crop
             object.__setattr__(self, "photo_image", self.image)
             object.__setattr__(self, "photo_silhouette", self.silhouette)
+        if self.photo_scene is None:  # kept through dataclasses.replace, so it stays the unreplaced photo
+            object.__setattr__(self, "photo_scene", self.photo_image)
 
     @property
     def side(self) -> int:

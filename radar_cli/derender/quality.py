@@ -11,6 +11,8 @@ import numpy as np
 from radar_cli.derender.inputs import Prepared
 from radar_cli.derender.renders import ViewRenderer
 from radar_cli.derender.state import ObjectState
+from radar_cli.masks.crop import outside_mask
+from radar_cli.masks.outline import outline_support
 from radar_cli.masks.quality import sor_score
 from radar_cli.masks.refine import iou
 
@@ -37,6 +39,9 @@ class QualityLimits:
     """Reconstruction PSNR (dB) inside the silhouette below this: review."""
     review_cut_edges: int = 3
     """An object running into this many photo edges or more: review (the photo may not show all of it)."""
+    review_support: float = 0.65
+    """Share of the silhouette's outline on an edge of the photo (`outline_support`) below this: review (the
+    silhouette does not sit on the object's edge)."""
 
 
 def psnr(a: np.ndarray, b: np.ndarray) -> float:
@@ -47,6 +52,20 @@ def psnr(a: np.ndarray, b: np.ndarray) -> float:
 
 def _round(value: float | None, digits: int = 4) -> float | None:
     return None if value is None or not math.isfinite(value) else round(float(value), digits)
+
+
+def support(prepared: Prepared) -> float | None:
+    """Outline support of the located silhouette (masks.outline) in the photo as photographed at N: readings
+    on the crop's padding beyond the photo's edge (where the frame cut the object) and on the appendages are
+    left out."""
+    sil = prepared.photo_silhouette
+    if sil is None or not sil.any():
+        return None
+    w, h = prepared.photo_size
+    measurable = ~outside_mask(prepared.crop, (h, w), prepared.side)
+    if prepared.appendages is not None:
+        measurable &= ~prepared.appendages
+    return outline_support(prepared.photo_scene, sil, measurable)
 
 
 def scores(prepared: Prepared, rendered: np.ndarray, recon: np.ndarray) -> dict:
@@ -66,6 +85,7 @@ def scores(prepared: Prepared, rendered: np.ndarray, recon: np.ndarray) -> dict:
         "symmetry": None if sil is None else _round(sor_score(sil)),
         "recon_psnr": _round(psnr(recon[region], prepared.photo_image[region]), 2) if region.any() else None,
         "appendage_fraction": None if app is None or not whole else _round(float(app.sum()) / whole),
+        "outline_support": _round(support(prepared)),
         "cut_edges": list(prepared.cut_edges),
         "frame_coverage": _round(prepared.frame_coverage),
         "silhouette_area": None if sil is None else _round(float(sil.mean())),
@@ -79,6 +99,7 @@ def judge(record: dict, limits: QualityLimits = QualityLimits()) -> tuple[str, l
     cov, sil_iou = record.get("frame_coverage"), record.get("silhouette_iou")
     area, sym = record.get("silhouette_area"), record.get("symmetry")
     app, rec_psnr = record.get("appendage_fraction"), record.get("recon_psnr")
+    outline = record.get("outline_support")
     if cov is not None and cov >= limits.fail_coverage:
         failed.append(f"silhouette covers {cov:.0%} of the photo")
     if area is not None and area < limits.min_area:
@@ -95,6 +116,8 @@ def judge(record: dict, limits: QualityLimits = QualityLimits()) -> tuple[str, l
         review.append(f"{app:.0%} of the object left out as appendage")
     if rec_psnr is not None and rec_psnr < limits.review_psnr:
         review.append(f"reconstruction far from the photo ({rec_psnr:.1f} dB)")
+    if outline is not None and outline < limits.review_support:
+        review.append(f"silhouette off the object's edge ({outline:.0%} of its outline on an edge)")
     if len(record.get("cut_edges", [])) >= limits.review_cut_edges:
         review.append(f"cut by {len(record['cut_edges'])} photo edges")
     if failed:

@@ -126,11 +126,16 @@ def spoilt_input(kind: str, variant: Variant, size: int):
 
         prepared = Prepared(crops.cut(rgb, box, size), box, rgb.shape[1::-1], silhouette=frame,
                             cut_edges=("top", "bottom", "left", "right"), frame_coverage=1.0)
-    else:
-        prepared = located_input(variant.image, size, "shifted")
+    else:  # at both sides, as a locator that found it would give it
+        prepared = located_input(variant.image, size, "shifted", backdrop="keep")
         cols = np.nonzero(prepared.silhouette.any(0))[0]
-        moved = np.roll(prepared.silhouette, max(1, (cols.max() - cols.min()) // 5), axis=1)
-        prepared = dataclasses.replace(prepared, silhouette=moved, image=white_backdrop(prepared.image, moved))
+        shift = max(1, (cols.max() - cols.min()) // 5)
+        moved = np.roll(prepared.silhouette, shift, axis=1)
+        photo_moved = np.roll(prepared.photo_silhouette, round(shift * prepared.side / size), axis=1)
+        prepared = dataclasses.replace(
+            prepared, silhouette=moved, image=white_backdrop(prepared.image, moved),
+            photo_silhouette=photo_moved, photo_image=white_backdrop(prepared.photo_scene, photo_moved),
+            backdrop="white")
     truth = crops.cut(variant.truth.astype(np.float32), prepared.crop, size, fill=0) > 0.5
     return prepared, iou(prepared.silhouette, truth)
 
@@ -174,7 +179,7 @@ def judge_status(results: Results, items: list[tuple[str, Variant]], batch: int 
         for j, i in enumerate(keys):
             state = ObjectState.from_decomposition(dec.select(j), predictor.setup.render, predictor.setup.camera)
             quality = assess(prepared[i], state)
-            results.rows[i].update(status=quality["status"], reasons=quality["reasons"])
+            results.rows[i].update(status=quality["status"], reasons=quality["reasons"], quality=quality)
 
 
 def iou_table(results: Results) -> str:
@@ -197,6 +202,17 @@ def status_table(results: Results) -> str:
         rows = [r for r in results.rows if "status" in r and test(r["iou"])]
         counts = [sum(r["status"] == s for r in rows) for s in ("ok", "review", "failed")]
         lines.append(f"| {label} | {len(rows)} | " + " | ".join(str(c) for c in counts) + " |")
+    return "\n".join(lines)
+
+
+def support_table(results: Results) -> str:
+    """Markdown: the outline support of the judged items per variant kind (None where not measurable)."""
+    lines = ["| variant | n | min support | mean support | max support |", "|---|---|---|---|---|"]
+    for kind in (*KINDS, "handles", *BROKEN):
+        s = np.array([r["quality"]["outline_support"] for r in results.rows if r["kind"] == kind
+                      and r.get("quality") and r["quality"].get("outline_support") is not None])
+        if len(s):
+            lines.append(f"| {kind} | {len(s)} | {s.min():.3f} | {s.mean():.3f} | {s.max():.3f} |")
     return "\n".join(lines)
 
 
@@ -258,6 +274,7 @@ def main() -> None:
         judge_status(results, items)
         print(status_table(results))
         print(iou_table(Results([r for r in results.rows if r["kind"] in BROKEN])))
+        print(support_table(results))
         for r in results.rows:
             if r["iou"] < 0.8 and r.get("status") == "ok" or r["iou"] > 0.95 and r.get("status") != "ok":
                 print(f"  {r['kind']:8s} {r['source']:28s} IoU {r['iou']:.3f} {r.get('status')}: "

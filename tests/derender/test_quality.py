@@ -19,7 +19,7 @@ from radar_cli.derender.report import by_status, write_summary
 from radar_cli.results import APPENDAGES_FILE, MATERIAL_FILE
 
 GOOD = {"silhouette_iou": 0.93, "symmetry": 0.95, "recon_psnr": 20.0, "appendage_fraction": 0.05,
-        "cut_edges": [], "frame_coverage": 0.3, "silhouette_area": 0.3}
+        "outline_support": 0.95, "cut_edges": [], "frame_coverage": 0.3, "silhouette_area": 0.3}
 
 
 def test_a_good_result_is_ok() -> None:
@@ -35,6 +35,7 @@ def test_a_good_result_is_ok() -> None:
     ({"appendage_fraction": 0.3}, "review", "appendage"),
     ({"recon_psnr": 8.0}, "review", "far from the photo"),
     ({"cut_edges": ["top", "bottom", "left"]}, "review", "3 photo edges"),
+    ({"outline_support": 0.4}, "review", "off the object's edge"),
     ({"silhouette_iou": None, "symmetry": None, "silhouette_area": None}, "review", "no silhouette"),
 ])
 def test_each_score_can_demote(change: dict, status: str, words: str) -> None:
@@ -54,6 +55,7 @@ def test_summary_lists_worst_first(tmp_path: Path) -> None:
     rows = list(csv.DictReader((tmp_path / "summary.csv").open()))
     assert [r["object"] for r in rows] == ["b", "c", "a"]
     assert rows[1]["status"] == "review" and rows[1]["reason"] == "y; z" and rows[0]["silhouette_iou"] == "0.93"
+    assert rows[0]["outline_support"] == "0.95"
 
 
 @pytest.mark.skipif(not any(ASSETS.glob("*.safetensors")), reason="no bundled model")
@@ -75,6 +77,7 @@ def test_derender_records_quality_and_appendages(tmp_path: Path) -> None:
     quality = record["quality"]
     assert quality["status"] in ("ok", "review") and {"top", "bottom"} <= set(quality["cut_edges"])
     assert quality["appendage_fraction"] > 0.03 and quality["frame_coverage"] < 0.9
+    assert quality["outline_support"] > 0.8
     appendages = np.asarray(Image.open(out / "amphora" / APPENDAGES_FILE)) > 127
     assert appendages.any() and appendages.shape == (record["resolution"],) * 2  # at the output side
     row = next(csv.DictReader((out / "summary.csv").open()))
