@@ -67,7 +67,7 @@ class LightFit:
     Attributes:
         env: 1 x He x We environment map (the starting map's size and mean).
         rmse: (fitted, start) root-mean-square error of the paints' model against the texture on the used
-            texels, display levels 0..1.
+            texels, display levels 0..1; `start` is the starting map pooled to the fitted map's coarse size.
         texels: texels used.
     """
 
