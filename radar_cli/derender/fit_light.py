@@ -17,7 +17,6 @@ same photograph (docs/refinement.md measures it).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import cv2
@@ -26,7 +25,7 @@ import torch
 import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig
-from radar_cli.render.lighting import GAMMA, env_directions
+from radar_cli.render.lighting import GAMMA, decompose, env_directions, phong_transport, tone_map
 from radar_cli.render.texture import unwrap
 from radar_cli.sor.surface import surface_grid
 
@@ -89,32 +88,13 @@ def smoothness(coarse: tuple[int, int]) -> torch.Tensor:
     wrapping round): (hc*wc) x (hc*wc), float64."""
     rows, cols = coarse
     index = torch.arange(rows * cols).reshape(rows, cols)
-    pairs = [(index[:, :], index.roll(-1, dims=1)), (index[:-1], index[1:])]
+    pairs = [(index, index.roll(-1, dims=1)), (index[:-1], index[1:])]
     a = torch.cat([p[0].reshape(-1) for p in pairs])
     b = torch.cat([p[1].reshape(-1) for p in pairs])
     diff = torch.zeros(a.numel(), rows * cols, dtype=torch.float64)
     diff[torch.arange(a.numel()), a] = 1.0
     diff[torch.arange(a.numel()), b] = -1.0
     return diff.T @ diff
-
-
-def light_transport(normals: torch.Tensor, view: torch.Tensor, alpha: float, size: tuple[int, int]
-                    ) -> tuple[torch.Tensor, torch.Tensor]:
-    """The diffuse and specular factors of each texel per environment texel (render.lighting's Phong, as
-    matrices: I_d = Kd @ env, I_s = Ks @ env).
-
-    Args:
-        normals, view: n x 3 unit vectors (camera frame), float64. alpha: shininess. size: (He, We).
-
-    Returns:
-        (Kd, Ks), each n x (He*We).
-    """
-    dirs, solid = env_directions(*size, device=normals.device, dtype=normals.dtype)
-    cos_light = normals @ dirs.T  # n x E
-    mirror = 2 * (normals * view).sum(-1, keepdim=True) * normals - view
-    cos_mirror = (mirror @ dirs.T).clamp_min(0.0) * (cos_light > 0)
-    lobe = torch.exp((alpha * torch.log(cos_mirror.clamp_min(1e-30))).clamp_min(-60.0))
-    return cos_light.clamp_min(0.0) * solid, (alpha + 1) / (2 * math.pi) * lobe * solid
 
 
 def paint_labels(albedo: np.ndarray, config: LightFitConfig) -> np.ndarray:
@@ -160,15 +140,16 @@ def fit_environment(crop: np.ndarray, silhouette: np.ndarray, radius: torch.Tens
     linear = shown ** GAMMA
     size = tuple(env.shape[-2:])
     up = upsampler(config.coarse, size)  # E x c
-    kd_full, ks_full = light_transport(normals[usable], view[usable], alpha, size)
+    kd_full, ks_full = phong_transport(normals[usable], view[usable], *env_directions(*size, dtype=dtype), alpha)
     kd, ks = kd_full @ up, ks_full @ up  # n x c
     start = env[0].double().cpu()
     coarse_start = F.adaptive_avg_pool2d(start[None, None], config.coarse).reshape(-1)
     mean = float(coarse_start.mean())
 
-    diffuse, specular = kd_full @ start.reshape(-1), ks_full @ start.reshape(-1)
-    divided = ((linear - rho * specular) / diffuse.clamp_min(1e-6)).clamp(0.0, 1.0) ** (1 / GAMMA)
-    labels = torch.from_numpy(paint_labels(divided.T.numpy(), config))
+    diffuse, specular = kd_full @ start.reshape(-1), ks_full @ start.reshape(-1)  # n each
+    divided = decompose(shown[None, :, None], diffuse[None, None], specular[None, None],
+                        torch.tensor([rho], dtype=dtype), GAMMA)[0, :, 0]  # 3 x n linear
+    labels = torch.from_numpy(paint_labels((divided ** (1 / GAMMA)).T.numpy(), config))
     keep = labels >= 0
     if int(keep.sum()) < 0.05 * g * g:
         return None
@@ -186,7 +167,7 @@ def fit_environment(crop: np.ndarray, silhouette: np.ndarray, radius: torch.Tens
         return (num / den.clamp_min(1e-12)).clamp_min(1e-3)[:, paint]
 
     def rmse(e: torch.Tensor, albedo: torch.Tensor) -> float:
-        drawn = (albedo * (kd @ e) + rho * (ks @ e)).clamp_min(1e-6) ** (1 / GAMMA)
+        drawn = tone_map(albedo * (kd @ e) + rho * (ks @ e))
         return float(((drawn - shown) ** 2).mean().sqrt())
 
     e = coarse_start.clone()

@@ -134,9 +134,8 @@ def _fit_light(refined: Decomposition, network_env: torch.Tensor, crop: np.ndarr
     with torch.no_grad():
         fit = fit_environment(crop, silhouette, refined.radius, refined.height, refined.pose, network_env,
                               float(refined.alpha[0]), float(refined.rho[0]), camera, config)
-    if fit is None:
-        return dataclasses.replace(refined, env=network_env), dataclasses.replace(report, light="kept")
-    report = dataclasses.replace(report, light_rmse=fit.rmse)
-    if not fit.rmse[0] < fit.rmse[1]:
+    if fit is not None:
+        report = dataclasses.replace(report, light_rmse=fit.rmse)
+    if fit is None or not fit.rmse[0] < fit.rmse[1]:
         return dataclasses.replace(refined, env=network_env), dataclasses.replace(report, light="kept")
     return dataclasses.replace(refined, env=fit.env), dataclasses.replace(report, light="fitted")

@@ -50,7 +50,7 @@ class Core:
         return float(self.appendages.sum() / total) if total else 0.0
 
 
-def _rotation(mask: np.ndarray, deg: float) -> np.ndarray:
+def upright_rotation(mask: np.ndarray, deg: float) -> np.ndarray:
     """2 x 3 affine rotating a mask by `deg` about its centroid."""
     ys, xs = np.nonzero(mask)
     return cv2.getRotationMatrix2D((float(xs.mean()), float(ys.mean())), deg, 1.0)
@@ -69,10 +69,10 @@ def find_axis(mask: np.ndarray) -> tuple[float, float]:
     small = cv2.resize(mask.astype(np.uint8), None, fx=k, fy=k, interpolation=cv2.INTER_AREA) > 0
     best, best_tilt = -1.0, 0.0
     for deg in TILTS_DEG:
-        score, _ = mirror_agreement(_warp(small, _rotation(small, deg)) if deg else small)
+        score, _ = mirror_agreement(_warp(small, upright_rotation(small, deg)) if deg else small)
         if score > best:
             best, best_tilt = score, deg
-    upright = _warp(mask, _rotation(mask, best_tilt)) if best_tilt else mask
+    upright = _warp(mask, upright_rotation(mask, best_tilt)) if best_tilt else mask
     _, axis = mirror_agreement(upright)
     return best_tilt, axis
 
@@ -151,7 +151,7 @@ def symmetric_core(mask: np.ndarray) -> Core:
         return Core(mask.copy(), np.zeros_like(mask), 0.0, 0.0, 0.0)
     tilt, axis = find_axis(mask)
     if tilt:
-        rot = _rotation(mask, tilt)
+        rot = upright_rotation(mask, tilt)
         core = _warp(upright_core(_warp(mask, rot), axis), cv2.invertAffineTransform(rot)) & mask
     else:
         core = upright_core(mask, axis)

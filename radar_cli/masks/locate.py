@@ -12,7 +12,7 @@ import numpy as np
 
 from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
-from radar_cli.masks.appendages import Core, find_axis, symmetric_core
+from radar_cli.masks.appendages import Core, find_axis, symmetric_core, upright_rotation
 from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fit_backdrop
 from radar_cli.masks.pipeline import Refined, Settings, check_photo, refine_detection, refine_window
 from radar_cli.masks.refine import main_component
@@ -170,8 +170,7 @@ def open_gaps(mask: np.ndarray, image: np.ndarray) -> np.ndarray:
         return mask
     depth = cv2.distanceTransform(np.pad(mask, 1).astype(np.uint8), cv2.DIST_L2, 3)[1:-1, 1:-1]
     tilt, axis = find_axis(mask)
-    ys, xs = np.nonzero(mask)
-    turn = cv2.getRotationMatrix2D((float(xs.mean()), float(ys.mean())), tilt, 1.0)  # as find_axis turns it
+    turn = upright_rotation(mask, tilt)
     width = cols.max() - cols.min() + 1
     gaps = np.zeros_like(mask)
     for i in range(1, count):

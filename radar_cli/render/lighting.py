@@ -73,6 +73,22 @@ def _step(x: torch.Tensor) -> torch.Tensor:
     return (x * BIG).clamp_(0.0, 1.0)
 
 
+def phong_transport(normals: torch.Tensor, view: torch.Tensor, dirs: torch.Tensor, solid: torch.Tensor,
+                    alpha: float) -> tuple[torch.Tensor, torch.Tensor]:
+    """Eq. 6-7 per light, as matrices: I_d = Kd @ E and I_s = Ks @ E for a map E flattened as `dirs`.
+
+    Args:
+        normals, view: n x 3 unit vectors (camera frame). dirs, solid: `env_directions` of the map.
+        alpha: shininess.
+
+    Returns:
+        (Kd, Ks), each n x (He*We).
+    """
+    ln, rp = _cosines(normals[None], view[None], dirs)
+    lobe = torch.exp((alpha * torch.log(rp[0].clamp_min(TINY))).clamp_min(LOG_FLOOR))
+    return ln[0].clamp_min(0.0) * solid, (alpha + 1) / (2 * math.pi) * lobe * solid
+
+
 def _phong_chunk(n: torch.Tensor, p: torch.Tensor, dirs: torch.Tensor, alpha: torch.Tensor):
     """Per-light terms for one chunk of samples (B x n x 3 each), all B x n x E: clamped L.N, R.P (0 where the
     light is below the surface or the lobe points away), log of it, and the lobe max(0, R.P)^alpha.
