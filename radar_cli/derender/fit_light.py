@@ -1,5 +1,5 @@
 """The environment map refined against the photograph's shading at the fitted shape (radar's addition, step 2 of
-`radar derender --refine shape`; docs/refinement.md).
+`radar derender --refine full`; docs/refinement.md).
 
 The photograph's frontal texture is unwrapped at the fitted shape onto a texel grid. Everything the shading
 cannot tell from the albedo is pinned by one assumption: a vessel is painted in a few colours. The texture
