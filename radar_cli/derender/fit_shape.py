@@ -6,8 +6,10 @@ another pitch draws. So pitch is searched over a grid, and at each candidate the
 in closed form (the axis from the rows' midpoints, the profile from the rows' widths, height and vertical offset
 from the outline's top and bottom); each candidate is scored by how well it draws the outline plus how much its
 profile has to bend. Where the open mouth is visible, the rim's front arc is an edge in the image (the inside is
-darker than the outer wall below the lip) and its contrast picks the pitch; a fine grid then narrows it, and the
-profile, height, roll and offset are polished by L-BFGS at full resolution with the pitch held.
+darker than the outer wall below the lip) and its contrast picks the pitch; where the pot is painted in
+horizontal bands, their edges run straight across the texture unwrapped at the right pitch (derender.bands), which
+picks the pitch or bounds the lip's search. A fine grid then narrows it, and the profile, height, roll and offset
+are polished by Adam at full resolution with the pitch held.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import torch
 import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig
+from radar_cli.derender.bands import BandCue, band_coherence, high_pass
 from radar_cli.sor.outline import Outline, disc_conics, mask_outline, outline, roots
 from radar_cli.sor.pose import rotation_matrix, translation
 
@@ -37,7 +40,13 @@ class ShapeFitConfig:
         roughness_weight: the profile's bending (sum of squared second differences x 1e3, at 64 rows).
         basin: the lip may pick any candidate whose outline score is within this of the best.
         lip_contrast: the lip is trusted where its contrast (grey levels 0..1) exceeds this.
-        prior_reach: without a lip, the outline's pick stays within this of the network's pitch (degrees).
+        band_ratio: painted bands pick the pitch where their coherence peaks at least this many times its lowest
+            over the grid.
+        band_reach: where they do, the lip is looked for within this of their peak (degrees).
+        bands: how the bands are read (derender.bands).
+        prior_reach: without bands or a lip, the outline's pick stays at most this above the network's pitch (degrees);
+            below it the outline is free (the network reads low pitches too high; a thick rim or a bevelled foot
+            makes the outline read too high).
         lip_tie: coarse candidates whose lip is at least this fraction of the strongest count as tied; the
             outline picks among them.
         lip_offset_px, fine_lip_offset_px: the lip's two sides are sampled this far above and below the arc (px
@@ -58,6 +67,9 @@ class ShapeFitConfig:
     lip_contrast: float = 0.1
     lip_tie: float = 0.9
     prior_reach: float = 3.0
+    band_ratio: float = 8.0
+    band_reach: float = 1.0
+    bands: BandCue = BandCue()
     lip_offset_px: float = 2.0
     fine_lip_offset_px: float = 1.0
     width_rounds: int = 3
@@ -73,7 +85,7 @@ class ShapeFit:
     Attributes:
         radius: 1 x rows radius column (fractions of r_max); height: 1; pose: 1 x 4 (pitch, roll, tx, ty).
         outline_error: mean distance in px (at the fitted resolution) between the fitted and the target outline.
-        pitch_cue: `lip` if the rim's front arc picked the pitch, else `outline`.
+        pitch_cue: what picked the pitch: `band` (painted bands), `lip` (the rim's front arc) or `outline`.
     """
 
     radius: torch.Tensor
@@ -222,37 +234,54 @@ def _search(target: Outline, grey: torch.Tensor, size: int, pitches: torch.Tenso
     return (radius, height, pose), score, lip_contrast(grey, radius, height, pose, lip_offset_px, camera)
 
 
-def _pick(score: torch.Tensor, contrast: torch.Tensor, config: ShapeFitConfig) -> tuple[int, str]:
-    """The candidate with the strongest lip inside the outline's basin if that lip is strong enough (the best
-    outline among near-ties), else the best outline score."""
-    lips = torch.where(score <= score.min() + config.basin, contrast, torch.full_like(contrast, -math.inf))
+def _pick(score: torch.Tensor, contrast: torch.Tensor, coherence: torch.Tensor | None, pitches: torch.Tensor,
+          config: ShapeFitConfig) -> tuple[int, str]:
+    """The cue that picks among candidates B (all within the outline's basin):
+    - painted bands, where their coherence peaks at least config.band_ratio x its lowest: they bound the lip's
+      search to config.band_reach of their peak (an edge above or below the rim can pass for it);
+    - the strongest lip if that lip is strong enough (the best outline among near-ties);
+    - else the bands' peak, else the best outline score."""
+    basin = score <= score.min() + config.basin
+    band = None
+    if coherence is not None:
+        peaks = torch.where(basin, coherence, torch.full_like(coherence, -math.inf))
+        if float(peaks.max()) > config.band_ratio * max(float(coherence.min()), 1e-9):
+            band = int(peaks.argmax())
+            basin = basin & ((pitches - pitches[band]).abs() <= config.band_reach)
+    lips = torch.where(basin, contrast, torch.full_like(contrast, -math.inf))
     if float(lips.max()) > config.lip_contrast:
         # several arcs as strong as the best (an edge inside the mouth that many arcs cross): the outline decides
         strong = lips >= config.lip_tie * lips.max()
         return int(torch.where(strong, score, torch.full_like(score, math.inf)).argmin()), "lip"
+    if band is not None:
+        return band, "band"
     return int(score.argmin()), "outline"
 
 
 def search_pitch(target: Outline, grey: torch.Tensor, size: int, config: ShapeFitConfig, camera: CameraConfig,
-                 prior_pitch: float | None = None) -> tuple[tuple[torch.Tensor, ...], str]:
+                 prior_pitch: float | None = None,
+                 bands: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[tuple[torch.Tensor, ...], str]:
     """Coarse then fine pitch grids; the fine one keeps the coarse one's cue. `grey`: 1 x 2 x N x N image and
-    coverage (lip_contrast). Returns ((radius, height, pose) of the chosen candidate, batch of one, float64; the
-    cue). Without a lip, the outline alone picks the pitch only within config.prior_reach of `prior_pitch` (the
-    network's) where one is given: a real rim's thickness and a foot's bevel draw arcs that the outline reads as
-    a higher pitch."""
+    coverage (lip_contrast); `bands`: the high-passed image and eroded silhouette (bands.high_pass), or None to
+    leave the bands out. Returns ((radius, height, pose) of the chosen candidate, batch of one, float64; the cue:
+    `band`, `lip` or `outline`). Without bands or a lip, the outline alone picks the pitch no more than
+    config.prior_reach above `prior_pitch` (the network's) where one is given: a real rim's thickness and a foot's
+    bevel draw arcs that the outline reads as a higher pitch. Lower picks are free: the network leans towards the
+    middle of the range, so it reads the low pitches where the mouth is a sliver too high."""
     roll, tx = axis_from_outline(target, size, camera)
     coarse = torch.arange(0.0, config.pitch_max + 1e-6, config.coarse_step, dtype=torch.float64)
-    _, score, contrast = _search(target, grey, size, coarse, roll, tx, config, camera, config.lip_offset_px)
-    best, cue = _pick(score, contrast, config)
+    shapes, score, contrast = _search(target, grey, size, coarse, roll, tx, config, camera, config.lip_offset_px)
+    coherence = None if bands is None else band_coherence(*bands, *shapes, config.bands, camera)
+    best, cue = _pick(score, contrast, coherence, coarse, config)
     if cue == "outline" and prior_pitch is not None:
-        near = (coarse - prior_pitch).abs() <= config.prior_reach
+        near = coarse - prior_pitch <= config.prior_reach
         if near.any():
             best = int(torch.where(near, score, torch.full_like(score, math.inf)).argmin())
     centre = float(coarse[best])
     fine = torch.arange(centre - config.coarse_step, centre + config.coarse_step + 1e-6, config.fine_step,
                         dtype=torch.float64).clamp(0.0, config.pitch_max)
     shapes, score, contrast = _search(target, grey, size, fine, roll, tx, config, camera, config.fine_lip_offset_px)
-    best = int(contrast.argmax()) if cue == "lip" else int(score.argmin())
+    best = int(contrast.argmax()) if cue == "lip" else int(score.argmin())  # bands place no finer than the outline
     return tuple(t[best : best + 1] for t in shapes), cue
 
 
@@ -286,7 +315,7 @@ def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = Shape
 
     Args:
         mask: N x N silhouette (bool or coverage in [0, 1]) of the crop.
-        grey: N x N grey image in [0, 1] of the same crop (the lip's contrast).
+        grey: N x N grey image in [0, 1] of the same crop (the lip's contrast and the painted bands).
         config: the fit's settings. camera: the fixed camera.
         prior_pitch: the network's pitch (degrees), bounding an outline-only pick (search_pitch).
 
@@ -297,7 +326,8 @@ def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = Shape
     grid = min(size, config.grid_size)
     coarse_target = mask_outline(downsample(mask, grid))
     grey_t = torch.from_numpy(np.stack([np.asarray(grey, np.float32), np.asarray(mask, np.float32)]))[None]
-    (radius, height, pose), cue = search_pitch(coarse_target, grey_t, grid, config, camera, prior_pitch)
+    bands = high_pass(grey, mask, config.bands.sigma_px)
+    (radius, height, pose), cue = search_pitch(coarse_target, grey_t, grid, config, camera, prior_pitch, bands)
     target = mask_outline(np.asarray(mask, np.float64))
     radius = correct_widths(target, size, radius, height, pose, config.width_rounds, camera)
     for level, steps in zip((grid, size), config.polish_steps):
