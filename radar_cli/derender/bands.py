@@ -16,9 +16,10 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 import torch
+import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig
-from radar_cli.render.texture import unwrap
+from radar_cli.sor.camera import project
 from radar_cli.sor.surface import surface_grid
 
 
@@ -64,9 +65,11 @@ def band_coherence(detail: np.ndarray, inner: np.ndarray, radius: torch.Tensor, 
         every candidate count, so the candidates are scored on the same part of the surface.
     """
     image = torch.from_numpy(np.stack([detail, inner])).to(radius.dtype)[None]  # 1 x 2 x N x N
-    batch = len(radius)
-    tex = unwrap(radius, height, pose, image.expand(batch, -1, -1, -1), (cue.rows, cue.cols), camera)
     grid = surface_grid(radius, height, pose, cue.rows, cue.cols, camera)
+    # render.texture.unwrap's sampling, on one image shared by every candidate
+    xy = project(grid.points, camera)  # B x R x C x 2
+    tex = F.grid_sample(image.expand(len(radius), -1, -1, -1), xy, mode="bilinear", padding_mode="border",
+                        align_corners=False)  # B x 2 x R x C
     facing = (grid.normals * grid.view).sum(-1)  # B x R x C
     usable = (tex[:, 1] > 0.999) & (facing > cue.min_facing)
     usable = usable & usable.all(0, keepdim=True)
