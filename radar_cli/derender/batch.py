@@ -12,8 +12,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from contextlib import contextmanager
-from typing import Callable, Iterator, Sequence, TypeVar
+from typing import Callable, Sequence, TypeVar
 
 import numpy as np
 import torch
@@ -30,6 +29,7 @@ from radar_cli.derender.upsample import full_resolution_state
 from radar_cli.errors import InputError, RadarError
 from radar_cli.fileio import remove_stale_temps
 from radar_cli.model.outputs import Decomposition
+from radar_cli.threads import torch_threads
 
 T, R = TypeVar("T"), TypeVar("R")
 EXPORT_THREADS = 1  # exports work on small tensors: one torch thread ran them 2-5x faster than two (2 cores)
@@ -72,17 +72,6 @@ class BatchSummary:
         rate = len(self.done) / self.seconds if self.seconds > 0 else 0.0
         return (f"{len(self.done)} de-rendered, {len(self.skipped)} skipped (already done), "
                 f"{len(self.failures)} failed in {self.seconds:.1f} s ({rate:.2f} objects/s)")
-
-
-@contextmanager
-def torch_threads(n: int) -> Iterator[None]:
-    """Run a block with `n` torch intra-op threads, then restore the previous setting."""
-    before = torch.get_num_threads()
-    torch.set_num_threads(n)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(before)
 
 
 def environments(paths: tuple[Path, ...], height: int, width: int) -> dict[str, np.ndarray]:

@@ -4,11 +4,16 @@
 The photograph's frontal texture is unwrapped at the fitted shape onto a texel grid. Everything the shading
 cannot tell from the albedo is pinned by one assumption: a vessel is painted in a few colours. The texture
 divided by the starting lighting is clustered into those paints (k-means in display colour); a texel far from
-its paint's centre (a thin line, an anti-aliased edge) is left out. Then, alternately, each paint's linear albedo
-follows in closed form from the lighting (least squares over its texels) and the lighting from the paints (a
-regularised least-squares solve for a coarse environment map: the image is linear in it), with shininess and
-specular albedo held at the network's. The map keeps the starting map's mean, since the albedo's brightness and
-the light's cannot be told apart.
+its paint's centre (a thin line, an anti-aliased edge) is left out. The image is linear in the environment map,
+and each paint's linear albedo follows from the lighting in closed form (least squares over its texels), with
+shininess and specular albedo held at the network's.
+
+The light is a few soft lights: spherical-Gaussian lobes (derender.light_lobes). A regularised least-squares
+solve for a coarse free map, alternating with the paints, finds where the light comes from; lobes started at
+its brightest peaks are fitted by Levenberg-Marquardt, again alternating with the paints, once for each of a few
+lobe counts. The photograph pins the light only loosely, and the fits disagree where it does not: the map is
+the mean of their maps. It keeps the starting map's mean, since the albedo's brightness and the light's cannot
+be told apart.
 
 Only the environment map is refined. Shininess and specular albedo are not: with the map unknown, a sharper light
 and a lower shininess, or a brighter light in the highlight's direction and a lower specular albedo, draw the
@@ -17,6 +22,7 @@ same photograph (docs/refinement.md measures it).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import cv2
@@ -25,9 +31,11 @@ import torch
 import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig
+from radar_cli.derender.light_lobes import LobeProblem, fit_lobes
 from radar_cli.render.lighting import GAMMA, decompose, env_directions, phong_transport, tone_map
 from radar_cli.render.texture import unwrap
 from radar_cli.sor.surface import surface_grid
+from radar_cli.threads import torch_threads
 
 
 @dataclass(frozen=True)
@@ -36,18 +44,27 @@ class LightFitConfig:
 
     Attributes:
         texels: side of the frontal texel grid the photograph is unwrapped onto.
-        coarse: (rows, columns) of the fitted map, upsampled bilinearly to the model's map.
+        coarse: (rows, columns) of the free map that places the lobes, upsampled bilinearly to the model's map.
         paints: k-means clusters of the divided albedo.
         min_share: a paint covering less than this share of the usable texels is left out.
         max_distance: texels further than this from their paint's centre (display colour, 0..1) are left out.
         min_facing: texels whose normal faces the camera less than this (cosine) are left out.
         coverage: texels less covered than this by the located silhouette are left out.
-        rounds: alternations of paints and lighting.
-        smooth: weight of the map's smoothness (squared differences of neighbouring coarse texels).
-        ridge: weight of the pull towards the starting map (relative to `smooth`).
+        rounds: alternations of paints and the free map.
+        smooth: weight of the free map's smoothness (squared differences of neighbouring coarse texels).
+        ridge: weight of the free map's pull towards the starting map (relative to `smooth`).
+        lobe_counts: the lobe fits whose maps are averaged, by their number of lobes (none: the free map).
+        lobe_rounds: alternations of paints and lobes in each lobe fit.
+        lobe_steps: Levenberg-Marquardt steps per alternation, at most.
+        lobe_tolerance: a step that lowers the squared residual by less than this share of it ends the
+            alternation's steps.
+        sharpness: (min, max) lobe sharpness lambda (at half its peak a lobe is 34 deg from its centre at 4, 9
+            deg at 60).
+        start_sharpness: every lobe's starting sharpness.
+        min_elevation: lobes stay at or above this elevation (deg): the lights are above the horizon.
     """
 
-    texels: int = 64
+    texels: int = 32
     coarse: tuple[int, int] = (8, 24)
     paints: int = 6
     min_share: float = 0.03
@@ -57,6 +74,13 @@ class LightFitConfig:
     rounds: int = 6
     smooth: float = 0.3
     ridge: float = 1.0
+    lobe_counts: tuple[int, ...] = (2, 3, 4)
+    lobe_rounds: int = 6
+    lobe_steps: int = 30
+    lobe_tolerance: float = 1e-3
+    sharpness: tuple[float, float] = (4.0, 60.0)
+    start_sharpness: float = 15.0
+    min_elevation: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -66,7 +90,7 @@ class LightFit:
     Attributes:
         env: 1 x He x We environment map (the starting map's size and mean).
         rmse: (fitted, start) root-mean-square error of the paints' model against the texture on the used
-            texels, display levels 0..1; `start` is the starting map pooled to the fitted map's coarse size.
+            texels, display levels 0..1.
         texels: texels used.
     """
 
@@ -111,6 +135,79 @@ def paint_labels(albedo: np.ndarray, config: LightFitConfig) -> np.ndarray:
     return np.where(keep, labels, -1)
 
 
+@dataclass(frozen=True)
+class _Texels:
+    """The used texels: Kd, Ks n x (He*We); linear and shown (display) texture 3 x n; paint n indices 0..P-1."""
+
+    kd: torch.Tensor
+    ks: torch.Tensor
+    linear: torch.Tensor
+    shown: torch.Tensor
+    paint: torch.Tensor
+    n_paints: int
+    rho: float
+
+    def paints(self, env: torch.Tensor) -> torch.Tensor:
+        """3 x n: each texel's paint albedo under a map (He*We; least squares over the paint's texels), linear."""
+        d, s = self.kd @ env, self.ks @ env
+        num = torch.zeros(3, self.n_paints, dtype=d.dtype).index_add_(1, self.paint, d * (self.linear - self.rho * s))
+        den = torch.zeros(self.n_paints, dtype=d.dtype).index_add_(0, self.paint, d * d)
+        return (num / den.clamp_min(1e-12)).clamp_min(1e-3)[:, self.paint]
+
+    def rmse(self, env: torch.Tensor) -> float:
+        """The paints' model under a map (He*We) against the texture, display levels."""
+        drawn = tone_map(self.paints(env) * (self.kd @ env) + self.rho * (self.ks @ env))
+        return float(((drawn - self.shown) ** 2).mean().sqrt())
+
+
+def _texels(crop: np.ndarray, silhouette: np.ndarray, geo: tuple[torch.Tensor, ...], start: torch.Tensor,
+            alpha: float, rho: float, camera: CameraConfig, config: LightFitConfig) -> _Texels | None:
+    """Unwrap the crop at the shape, keep the usable texels and cluster them into paints under `start`
+    (He x We float64); None when under 5% of the grid is usable."""
+    g = config.texels
+    dtype = torch.float64
+    image = torch.from_numpy(np.ascontiguousarray(crop)).permute(2, 0, 1)[None].to(dtype) / 255.0
+    cover = torch.from_numpy(silhouette.astype(np.float64))[None, None]
+    texture = unwrap(*geo, torch.cat([image, cover], 1), (g, g), camera)[0].reshape(4, -1)  # 4 x g*g
+    grid = surface_grid(*geo, g, g, camera)
+    normals, view = grid.normals[0].reshape(-1, 3), grid.view[0].reshape(-1, 3)
+    usable = (texture[3] > config.coverage) & ((normals * view).sum(-1) > config.min_facing)
+    if int(usable.sum()) < 0.05 * g * g:
+        return None
+    shown = texture[:3, usable]  # 3 x n display
+    kd, ks = phong_transport(normals[usable], view[usable], *env_directions(*start.shape, dtype=dtype), alpha)
+    diffuse, specular = kd @ start.reshape(-1), ks @ start.reshape(-1)  # n each
+    divided = decompose(shown[None, :, None], diffuse[None, None], specular[None, None],
+                        torch.tensor([rho], dtype=dtype), GAMMA)[0, :, 0]  # 3 x n linear
+    labels = torch.from_numpy(paint_labels((divided ** (1 / GAMMA)).T.numpy(), config))
+    keep = labels >= 0
+    if int(keep.sum()) < 0.05 * g * g:
+        return None
+    _, paint = torch.unique(labels[keep], return_inverse=True)  # n paint indices 0..P-1
+    shown = shown[:, keep]
+    return _Texels(kd[keep], ks[keep], shown ** GAMMA, shown, paint, int(paint.max()) + 1, rho)
+
+
+def _free_map(texels: _Texels, start: torch.Tensor, config: LightFitConfig) -> torch.Tensor:
+    """The coarse free map (regularised least squares, alternating with the paints), upsampled: He x We."""
+    up = upsampler(config.coarse, tuple(start.shape))  # E x c
+    kd, ks = texels.kd @ up, texels.ks @ up  # n x c
+    coarse_start = F.adaptive_avg_pool2d(start[None, None], config.coarse).reshape(-1)
+    mean = float(coarse_start.mean())
+    smooth = smoothness(config.coarse)
+    eye = torch.eye(smooth.shape[0], dtype=torch.float64)
+    e = coarse_start.clone()
+    for _ in range(config.rounds):
+        albedo = texels.paints(up @ e)
+        system = torch.cat([albedo[c][:, None] * kd + texels.rho * ks for c in range(3)])  # 3n x c
+        weight = config.smooth * float((system * system).sum()) / (10 * system.shape[1])
+        lhs = system.T @ system + weight * (smooth + config.ridge * eye)
+        rhs = system.T @ texels.linear.reshape(-1) + weight * config.ridge * coarse_start
+        e = torch.linalg.solve(lhs, rhs).clamp_min(0.0)
+        e = e * (mean / max(float(e.mean()), 1e-12))
+    return (up @ e).reshape(start.shape)
+
+
 def fit_environment(crop: np.ndarray, silhouette: np.ndarray, radius: torch.Tensor, height: torch.Tensor,
                     pose: torch.Tensor, env: torch.Tensor, alpha: float, rho: float, camera: CameraConfig,
                     config: LightFitConfig = LightFitConfig()) -> LightFit | None:
@@ -125,61 +222,29 @@ def fit_environment(crop: np.ndarray, silhouette: np.ndarray, radius: torch.Tens
     Returns:
         The fit, or None when too few texels are usable (under 5% of the grid).
     """
-    g = config.texels
-    dtype = torch.float64
+    # one thread: the products are small, and the same input gives the same bits whatever the caller's threads
+    with torch_threads(1):
+        return _fit(crop, silhouette, radius, height, pose, env, alpha, rho, camera, config)
+
+
+def _fit(crop: np.ndarray, silhouette: np.ndarray, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
+         env: torch.Tensor, alpha: float, rho: float, camera: CameraConfig, config: LightFitConfig) -> LightFit | None:
+    """fit_environment's work, on the calling thread's torch threads."""
     geo = (radius.double().cpu(), height.double().cpu(), pose.double().cpu())
-    image = torch.from_numpy(np.ascontiguousarray(crop)).permute(2, 0, 1)[None].to(dtype) / 255.0
-    cover = torch.from_numpy(silhouette.astype(np.float64))[None, None]
-    texture = unwrap(*geo, torch.cat([image, cover], 1), (g, g), camera)[0].reshape(4, -1)  # 4 x g*g
-    grid = surface_grid(*geo, g, g, camera)
-    normals, view = grid.normals[0].reshape(-1, 3), grid.view[0].reshape(-1, 3)
-    usable = (texture[3] > config.coverage) & ((normals * view).sum(-1) > config.min_facing)
-    if int(usable.sum()) < 0.05 * g * g:
-        return None
-    shown = texture[:3, usable]  # 3 x n display
-    linear = shown ** GAMMA
-    size = tuple(env.shape[-2:])
-    up = upsampler(config.coarse, size)  # E x c
-    kd_full, ks_full = phong_transport(normals[usable], view[usable], *env_directions(*size, dtype=dtype), alpha)
-    kd, ks = kd_full @ up, ks_full @ up  # n x c
     start = env[0].double().cpu()
-    coarse_start = F.adaptive_avg_pool2d(start[None, None], config.coarse).reshape(-1)
-    mean = float(coarse_start.mean())
-
-    diffuse, specular = kd_full @ start.reshape(-1), ks_full @ start.reshape(-1)  # n each
-    divided = decompose(shown[None, :, None], diffuse[None, None], specular[None, None],
-                        torch.tensor([rho], dtype=dtype), GAMMA)[0, :, 0]  # 3 x n linear
-    labels = torch.from_numpy(paint_labels((divided ** (1 / GAMMA)).T.numpy(), config))
-    keep = labels >= 0
-    if int(keep.sum()) < 0.05 * g * g:
+    texels = _texels(crop, silhouette, geo, start, alpha, rho, camera, config)
+    if texels is None:
         return None
-    linear, shown, kd, ks = linear[:, keep], shown[:, keep], kd[keep], ks[keep]
-    _, paint = torch.unique(labels[keep], return_inverse=True)  # n paint indices 0..P-1
-    n_paints = int(paint.max()) + 1
-    smooth = smoothness(config.coarse)
-    eye = torch.eye(smooth.shape[0], dtype=dtype)
-
-    def paints(e: torch.Tensor) -> torch.Tensor:
-        """3 x n: each texel's paint albedo (least squares over the paint's texels), linear."""
-        d, s = kd @ e, ks @ e
-        num = torch.zeros(3, n_paints, dtype=dtype).index_add_(1, paint, d * (linear - rho * s))
-        den = torch.zeros(n_paints, dtype=dtype).index_add_(0, paint, d * d)
-        return (num / den.clamp_min(1e-12)).clamp_min(1e-3)[:, paint]
-
-    def rmse(e: torch.Tensor, albedo: torch.Tensor) -> float:
-        drawn = tone_map(albedo * (kd @ e) + rho * (ks @ e))
-        return float(((drawn - shown) ** 2).mean().sqrt())
-
-    e = coarse_start.clone()
-    start_rmse = rmse(e, paints(e))
-    for _ in range(config.rounds):
-        albedo = paints(e)
-        system = torch.cat([albedo[c][:, None] * kd + rho * ks for c in range(3)])  # 3n x c
-        weight = config.smooth * float((system * system).sum()) / (10 * system.shape[1])
-        lhs = system.T @ system + weight * (smooth + config.ridge * eye)
-        rhs = system.T @ linear.reshape(-1) + weight * config.ridge * coarse_start
-        e = torch.linalg.solve(lhs, rhs).clamp_min(0.0)
-        e = e * (mean / max(float(e.mean()), 1e-12))
-    fitted = (up @ e).reshape(1, *size).clamp_min(0.0)
+    free = _free_map(texels, start, config)
+    transport = torch.cat([texels.kd, texels.ks]).T.float().contiguous()  # E x 2n
+    problem = LobeProblem(transport, texels.linear, rho, tuple(start.shape))
+    maps = []
+    for k in config.lobe_counts:
+        lobes = fit_lobes(problem, free, k, texels.paints, config.lobe_rounds, config.lobe_steps,
+                          config.lobe_tolerance, config.sharpness, config.start_sharpness,
+                          math.radians(config.min_elevation))
+        maps.append(lobes / max(float(lobes.mean()), 1e-12))
+    fitted = torch.stack(maps).mean(0).clamp_min(0.0) if maps else free.reshape(-1)
     fitted = fitted * (float(start.mean()) / max(float(fitted.mean()), 1e-12))
-    return LightFit(fitted.to(env.dtype).to(env.device), (rmse(e, paints(e)), start_rmse), int(keep.sum()))
+    rmse = (texels.rmse(fitted), texels.rmse(start.reshape(-1)))
+    return LightFit(fitted.reshape(1, *start.shape).to(env.dtype).to(env.device), rmse, int(texels.paint.numel()))

@@ -1,5 +1,6 @@
 """The environment map fitted to a synthetic vase's shading at its true shape: closer to the true map than the
-map it starts from, drawing the texture better, the same every time; too little surface gives no fit."""
+map it starts from and than the free map alone, drawing the texture better, the same every time; too little
+surface gives no fit."""
 
 from __future__ import annotations
 
@@ -31,15 +32,20 @@ def _blurred(env: np.ndarray) -> torch.Tensor:
 
 @pytest.mark.parametrize("index", [0, 2])
 def test_fit_moves_the_map_towards_the_truth(index):
+    """The lobes place the lights: their map is closer to the truth than the start by far, and than the free map
+    they start from (measured: 0.06 and 0.02 x the start's error, 0.3 and 0.05 x the free map's)."""
     image, mask, shape, truth, params = _sample(index)
     start = _blurred(truth)
     fit = fit_environment(image, mask, *shape, start, params["alpha"], params["rho"], CameraConfig())
-    assert fit is not None
+    free = fit_environment(image, mask, *shape, start, params["alpha"], params["rho"], CameraConfig(),
+                           LightFitConfig(lobe_counts=()))
+    assert fit is not None and free is not None
     assert fit.env.shape == start.shape and float(fit.env.min()) >= 0
     assert fit.env.mean().item() == pytest.approx(start.mean().item(), rel=1e-4)
     assert fit.rmse[0] < fit.rmse[1]
     before, after = env_error(start[0].numpy(), truth), env_error(fit.env[0].numpy(), truth)
-    assert after < 0.7 * before, (before, after)
+    assert after < 0.2 * before, (before, after)
+    assert after < 0.5 * env_error(free.env[0].numpy(), truth)
 
 
 def test_fit_is_deterministic():
