@@ -22,6 +22,7 @@ from radar_cli.masks.refine import iou
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.raycast import cast_rays
 from radar_cli.sor.outline import mask_outline, outline
+from radar_cli.threads import torch_threads
 
 RefineMode = Literal["full", "shape", "none"]
 REFINE_MODES: tuple[RefineMode, ...] = ("full", "shape", "none")
@@ -106,8 +107,9 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
                                      absolute=True)[0])
     grey = crop.astype(np.float32).mean(axis=2) / 255.0
     try:
-        fit = fit_shape(silhouette, grey, config, camera, float(dec.pose[0, 0]))
-        refined_iou = silhouette_iou(fit.radius, fit.height, fit.pose, silhouette, camera)
+        with torch_threads(1):  # the same bits whatever the caller's thread count (torch's sums split by thread)
+            fit = fit_shape(silhouette, grey, config, camera, float(dec.pose[0, 0]))
+            refined_iou = silhouette_iou(fit.radius, fit.height, fit.pose, silhouette, camera)
     except FIT_ERRORS as e:
         return None, RefineReport("fallback", f"the fit failed ({type(e).__name__}: {e})", size,
                                  outline_px=(float("nan"), network_px), iou=(float("nan"), network_iou),
