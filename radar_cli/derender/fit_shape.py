@@ -23,7 +23,7 @@ import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig
 from radar_cli.derender.bands import BandCue, band_coherence, high_pass
-from radar_cli.sor.outline import Outline, disc_conics, mask_outline, outline, roots
+from radar_cli.sor.outline import Outline, disc_conics, mask_outline, outline, roots, vertical_extent
 from radar_cli.sor.pose import rotation_matrix, translation
 
 
@@ -184,9 +184,8 @@ def closed_form(target: Outline, size: int, pitches: torch.Tensor, roll: float, 
     unit = 2.0 / size  # r_max fractions per pixel at the object's distance
     for _ in range(config.placement_iterations):
         radius = profile_from_widths(target, height, pose, config.rows, size, camera)
-        drawn = outline(radius, height, pose, size, camera)
-        d_top = top - torch.from_numpy(np.nanmin(drawn.top.numpy(), 1))
-        d_bottom = bottom - torch.from_numpy(np.nanmax(drawn.bottom.numpy(), 1))
+        drawn_top, drawn_bottom = vertical_extent(radius, height, pose, size, camera)
+        d_top, d_bottom = top - drawn_top, bottom - drawn_bottom
         height = (height + (d_bottom - d_top) / 2 * unit / torch.cos(torch.deg2rad(pose[:, 0]))).clamp(0.3, 1.2)
         pose[:, 3] = pose[:, 3] - (d_top + d_bottom) / 2 * unit
     return profile_from_widths(target, height, pose, config.rows, size, camera), height, pose

@@ -37,16 +37,17 @@ class Outline:
     bottom: torch.Tensor
 
 
-def disc_conics(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, n_discs: int,
+def disc_frames(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, n_discs: int,
                 camera: CameraConfig) -> torch.Tensor:
-    """The image conics of n_discs discs evenly spaced along the axis (top to bottom), in normalised image
-    coordinates (x right, y up, both tan(fov/2) = 1): point m = (x, y, 1) is on disc k's ellipse iff m^T Q_k m = 0.
+    """The maps from the unit circle to the image of n_discs discs evenly spaced along the axis (top to bottom):
+    disc k's rim point at angle t is g_k (cos t, sin t, 1), in homogeneous normalised image coordinates (x right,
+    y up, both tan(fov/2) = 1).
 
     Args:
         radius: B x L radius column; height: B; pose: B x 4 (as cast_rays). Computed in float64.
 
     Returns:
-        B x n_discs x 3 x 3 symmetric conics, each scaled to unit norm.
+        B x n_discs x 3 x 3.
     """
     dt = torch.float64
     radius, height, pose = radius.to(dt), height.to(dt), pose.to(dt)
@@ -59,10 +60,40 @@ def disc_conics(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, 
     e3 = r[..., None] * rot[:, None, :, 2]
     tan = math.tan(math.radians(camera.fov_deg) / 2.0)
     scale = torch.tensor([1.0 / tan, 1.0 / tan, 1.0], dtype=dt, device=radius.device)
-    g = torch.stack([e1, e3, centre], dim=-1) * scale[:, None]  # B x K x 3 x 3: (cos, sin, 1) -> image
-    adj = _adjugate(g)  # proportional to g^-1
-    q = adj.transpose(-1, -2) @ torch.diag(torch.tensor([1.0, 1.0, -1.0], dtype=dt, device=radius.device)) @ adj
+    return torch.stack([e1, e3, centre], dim=-1) * scale[:, None]
+
+
+UNIT_CIRCLE = torch.diag(torch.tensor([1.0, 1.0, -1.0], dtype=torch.float64))  # x^2 + y^2 - 1 = 0, self-dual
+
+
+def disc_conics(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, n_discs: int,
+                camera: CameraConfig) -> torch.Tensor:
+    """The image conics of n_discs discs evenly spaced along the axis (top to bottom), in normalised image
+    coordinates (x right, y up, both tan(fov/2) = 1): point m = (x, y, 1) is on disc k's ellipse iff m^T Q_k m = 0.
+
+    Args:
+        radius: B x L radius column; height: B; pose: B x 4 (as cast_rays). Computed in float64.
+
+    Returns:
+        B x n_discs x 3 x 3 symmetric conics, each scaled to unit norm.
+    """
+    adj = _adjugate(disc_frames(radius, height, pose, n_discs, camera))  # proportional to g^-1
+    q = adj.transpose(-1, -2) @ UNIT_CIRCLE.to(adj.device) @ adj
     return q / q.flatten(-2).norm(dim=-1)[..., None, None]
+
+
+def vertical_extent(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, size: int,
+                    camera: CameraConfig = CameraConfig(), n_discs: int | None = None) -> tuple[torch.Tensor,
+                                                                                               torch.Tensor]:
+    """The silhouette's top and bottom rows in an S x S image (pixel-centre coordinates, B each): the extremes
+    of the discs' ellipses, each in closed form from its dual conic g D g^T (the horizontal lines y = c tangent
+    to it), far cheaper than the full outline. Same discs as outline()."""
+    g = disc_frames(radius, height, pose, n_discs or n_discs_for(size), camera)  # B x K x 3 x 3
+    dual = g @ UNIT_CIRCLE.to(g.device) @ g.transpose(-1, -2)
+    # line (0, 1, -c) tangent: dual_11 - 2 c dual_12 + c^2 dual_22 = 0
+    low, high = roots(dual[..., 2, 2], -dual[..., 1, 2], dual[..., 1, 1])  # B x K normalised y, up
+    to_row = lambda y: (1.0 - y) * (size / 2.0) - 0.5  # noqa: E731 (normalised y up -> pixel-centre row)
+    return to_row(_extreme(high, torch.amax, -math.inf)), to_row(_extreme(low, torch.amin, math.inf))
 
 
 def _adjugate(m: torch.Tensor) -> torch.Tensor:
@@ -77,31 +108,102 @@ def n_discs_for(size: int, height_frac: float = 2.0) -> int:
     return max(64, int(math.ceil(SUBROWS_PER_PIXEL * size * height_frac)))
 
 
-def _row_ends(q: torch.Tensor, y: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+def _row_ends(q: torch.Tensor, lines: tuple[float, float, int]) -> tuple[torch.Tensor, torch.Tensor]:
     """Left and right ends (normalised x) of the union of the discs' ellipses along horizontal lines.
 
     Two parts, each exact where the other is not: the ellipses' own crossings of each line (the caps' arcs), and
     the polylines through consecutive ellipses' leftmost and rightmost points (the side contour; a disc seen
-    almost edge-on is a thin line that most rows fall between).
+    almost edge-on is a thin line that most rows fall between). Each ellipse and each segment is evaluated, without
+    gradients, only on the lines its height range spans (_band), so the cost follows the area the parts cover,
+    not K x N; then each line's winner is evaluated again, so the gradient's graph holds N values, not K x W.
 
     Args:
-        q: B x K x 3 x 3 conics, discs in order along the axis. y: N line heights (normalised, up).
+        q: B x K x 3 x 3 conics, discs in order along the axis. lines: (y0, dy, N): the line heights
+            y0 + n dy (normalised, up), n = 0 .. N-1.
 
     Returns:
         (left, right), B x N each, NaN where a line misses every ellipse.
     """
-    q00, q01, q02 = q[..., 0, 0], q[..., 0, 1], q[..., 0, 2]
-    q11, q12, q22 = q[..., 1, 1], q[..., 1, 2], q[..., 2, 2]
-    y_ = y[None, None, :]
-    lo, hi = roots(q00[..., None], (q01[..., None] * y_ + q02[..., None]),
-                    q11[..., None] * y_ * y_ + 2 * q12[..., None] * y_ + q22[..., None])  # B x K x N
+    conic = tuple(q[..., i, j] for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)))  # B x K each
+    q00, q01, q02, q11, q12, q22 = conic
     # leftmost / rightmost points: d/dy (m^T Q m) = 0, i.e. y = a x + b on the ellipse
     a, b = -q01 / q11, -q12 / q11
     xa, xb = roots(q00 + 2 * q01 * a + q11 * a * a, q01 * b + q11 * a * b + q02 + q12 * a,
-                    q11 * b * b + 2 * q12 * b + q22)  # B x K
-    left = torch.cat([lo, _polyline(xa, a * xa + b, y)], dim=1)
-    right = torch.cat([hi, _polyline(xb, a * xb + b, y)], dim=1)
-    return _extreme(left, torch.amin, math.inf), _extreme(right, torch.amax, -math.inf)
+                   q11 * b * b + 2 * q12 * b + q22)  # B x K
+    sides = ((xa, a * xa + b), (xb, a * xb + b))
+    y0, dy, n = lines
+    with torch.no_grad():
+        dual = _adjugate(q)  # the lines y = c tangent to an ellipse: dual_11 - 2 c dual_12 + c^2 dual_22 = 0
+        index, y = _band(*roots(dual[..., 2, 2], -dual[..., 1, 2], dual[..., 1, 1]), lines)  # B x K x W
+        crossings = _crossings(tuple(c.detach()[..., None] for c in conic), y)  # (lo, hi), B x K x W each
+        segments = []
+        for x, ys in sides:
+            seg_index, at = _band(ys[:, :-1], ys[:, 1:], lines)  # B x (K-1) x W
+            segments.append((_segment(x.detach()[:, :-1, None], x.detach()[:, 1:, None], ys.detach()[:, :-1, None],
+                                      ys.detach()[:, 1:, None], at), seg_index))
+        winners = [(_winner(crossings[i], index, n, reduce), _winner(*segments[i], n, reduce))
+                   for i, reduce in enumerate(("amin", "amax"))]
+    heights = y0 + torch.arange(n, device=q.device).to(q.dtype) * dy  # N
+    ends = []
+    for i, ((disc, segment), (x, ys)) in enumerate(zip(winners, sides)):
+        k = disc.clamp(max=q.shape[1] - 1)
+        crossing = _crossings(tuple(c.gather(1, k) for c in conic), heights[None])[i]
+        crossing = torch.where(disc < q.shape[1], crossing, torch.full_like(crossing, math.nan))
+        k = segment.clamp(max=q.shape[1] - 2)
+        side = _segment(x.gather(1, k), x.gather(1, k + 1), ys.gather(1, k), ys.gather(1, k + 1), heights[None])
+        side = torch.where(segment < q.shape[1] - 1, side, torch.full_like(side, math.nan))
+        ends.append(torch.fmin(crossing, side) if i == 0 else torch.fmax(crossing, side))
+    return ends[0], ends[1]
+
+
+def _crossings(conic: tuple[torch.Tensor, ...], y: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """The smaller and larger x where the lines at heights y cross ellipses (q00, q01, q02, q11, q12, q22, each
+    broadcasting with y), NaN where they miss."""
+    q00, q01, q02, q11, q12, q22 = conic
+    return roots(q00, q01 * y + q02, q11 * y * y + 2 * q12 * y + q22)
+
+
+def _segment(x0: torch.Tensor, x1: torch.Tensor, y0: torch.Tensor, y1: torch.Tensor, at: torch.Tensor) -> torch.Tensor:
+    """x of the segments from (x0, y0) to (x1, y1) on the lines y = at (all broadcasting), NaN off their
+    y-range."""
+    span = y1 - y0
+    w = (at - y0) / torch.where(span.abs() > 1e-12, span, torch.full_like(span, 1e-12))
+    inside = (w >= 0) & (w <= 1)
+    return torch.where(inside, x0 + w * (x1 - x0), torch.full_like(w, math.nan))
+
+
+def _band(low: torch.Tensor, high: torch.Tensor, lines: tuple[float, float, int]) -> tuple[torch.Tensor,
+                                                                                        torch.Tensor]:
+    """The lines each of B x K height ranges [low, high] spans (NaN: none), one spare either side: indices
+    B x K x W into the N lines (N where the range needs fewer than W: a line past the last, whose values
+    _winner drops) and their heights B x K x W. No gradients."""
+    y0, dy, n = lines
+    a, b = (low - y0) / dy, (high - y0) / dy
+    first = (torch.fmin(a, b).floor() - 1).clamp(0, n)
+    last = (torch.fmax(a, b).ceil() + 1).clamp(-1, n - 1)
+    spans = ~(first.isnan() | last.isnan()) & (last >= first)
+    first = torch.where(spans, first, torch.zeros_like(first)).long()
+    last = torch.where(spans, last, torch.full_like(last, -1.0)).long()
+    width = max(int((last - first).max()) + 1, 1) if bool(spans.any()) else 1
+    index = first[..., None] + torch.arange(width, device=low.device)  # B x K x W
+    index = torch.where(index <= last[..., None], index, torch.full_like(index, n))
+    return index, y0 + index.to(low.dtype) * dy
+
+
+def _winner(values: torch.Tensor, index: torch.Tensor, n: int, reduce: str) -> torch.Tensor:
+    """Per line, which of the K parts holds the min or max (reduce: `amin` or `amax`) of B x K x W values on the
+    lines `index` (NaN and index N ignored): B x N part indices, K where a line has none (the first on a tie)."""
+    fill = math.inf if reduce == "amin" else -math.inf
+    found = ~values.isnan() & (index < n)
+    flat = index.flatten(1)
+    src = torch.where(found, values, torch.full_like(values, fill)).flatten(1)
+    best = torch.full((values.shape[0], n + 1), fill, dtype=values.dtype, device=values.device)
+    best = best.scatter_reduce(1, flat, src, reduce)
+    parts = torch.arange(values.shape[1], device=values.device)[None, :, None].expand_as(index)
+    hit = found.flatten(1) & (src == best.gather(1, flat))
+    part = torch.where(hit, parts.flatten(1), torch.full_like(flat, values.shape[1]))
+    none = torch.full((values.shape[0], n + 1), values.shape[1], dtype=flat.dtype, device=values.device)
+    return none.scatter_reduce(1, flat, part, "amin")[:, :n]
 
 
 def roots(qa: torch.Tensor, qb: torch.Tensor, qc: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
@@ -113,17 +215,6 @@ def roots(qa: torch.Tensor, qb: torch.Tensor, qc: torch.Tensor) -> tuple[torch.T
     t1, t2 = (-qb - root) * inv, (-qb + root) * inv
     nan = torch.full_like(t1, math.nan)
     return torch.where(real, torch.minimum(t1, t2), nan), torch.where(real, torch.maximum(t1, t2), nan)
-
-
-def _polyline(x: torch.Tensor, y: torch.Tensor, at: torch.Tensor) -> torch.Tensor:
-    """x of the polylines through B x K points (x, y), in order, on the lines y = at (N): B x (K-1) x N, NaN
-    off each segment's y-range."""
-    x0, x1, y0, y1 = x[:, :-1, None], x[:, 1:, None], y[:, :-1, None], y[:, 1:, None]
-    at = at[None, None, :]
-    span = y1 - y0
-    w = (at - y0) / torch.where(span.abs() > 1e-12, span, torch.full_like(span, 1e-12))
-    inside = (w >= 0) & (w <= 1)
-    return torch.where(inside, x0 + w * (x1 - x0), torch.full_like(w, math.nan))
 
 
 def _extreme(values: torch.Tensor, reduce, fill: float) -> torch.Tensor:
@@ -148,10 +239,10 @@ def outline(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, size
         Outline in pixel-centre coordinates (float64).
     """
     q = disc_conics(radius, height, pose, n_discs or n_discs_for(size), camera)  # B x K x 3 x 3
-    c = (torch.arange(size, dtype=q.dtype, device=q.device) + 0.5) * (2.0 / size) - 1.0  # pixel centres
-    left, right = _row_ends(q, -c)  # rows: normalised y = -c (up)
+    first, step = 1.0 / size - 1.0, 2.0 / size  # pixel centres, normalised
+    left, right = _row_ends(q, (-first, -step, size))  # rows: normalised y = -c (up)
     swap = SWAP_XY.to(q.device)
-    low, high = _row_ends(swap @ q @ swap, c)  # columns: the same with x and y exchanged
+    low, high = _row_ends(swap @ q @ swap, (first, step, size))  # columns: the same with x and y exchanged
     to_px = lambda t: (t + 1.0) * (size / 2.0) - 0.5  # noqa: E731 (normalised -> pixel-centre index)
     return Outline(to_px(left), to_px(right), to_px(-high), to_px(-low))
 

@@ -8,7 +8,7 @@ import torch
 
 from radar_cli.config import CameraConfig
 from radar_cli.render.raycast import cast_rays
-from radar_cli.sor.outline import mask_outline, outline
+from radar_cli.sor.outline import mask_outline, outline, vertical_extent
 
 SIZE = 192
 
@@ -51,3 +51,35 @@ def test_mask_outline_sub_pixel():
     assert ends.left[0, 2] == pytest.approx(2 / 3) and ends.left[0, 1] == pytest.approx(1.5)
     assert ends.right[0, 1] == pytest.approx(5.5) and np.isnan(ends.left[0, 0].item())
     assert ends.top[0, 3] == pytest.approx(0.5) and ends.bottom[0, 3] == pytest.approx(3.5)
+
+
+@pytest.mark.parametrize("pitch", [0.5, 12.0, 24.0])
+def test_vertical_extent_is_the_outlines_top_and_bottom(pitch):
+    radius, height, pose = _vase(pitch, 3.0, 0.04, -0.03)
+    drawn = outline(radius, height, pose, SIZE, CameraConfig())
+    top, bottom = vertical_extent(radius, height, pose, SIZE, CameraConfig())
+    # the outline samples the silhouette's columns at pixel centres; the extent is the exact extreme
+    assert float(top[0]) <= np.nanmin(drawn.top[0].numpy()) + 1e-9
+    assert float(top[0]) == pytest.approx(np.nanmin(drawn.top[0].numpy()), abs=0.02)
+    assert float(bottom[0]) >= np.nanmax(drawn.bottom[0].numpy()) - 1e-9
+    assert float(bottom[0]) == pytest.approx(np.nanmax(drawn.bottom[0].numpy()), abs=0.02)
+
+
+def test_outline_gradient_matches_finite_differences():
+    radius, height, pose = (t.double() for t in _vase(9.0, 2.0, 0.03, 0.02))
+    theta = torch.cat([radius[0], height, pose[0]]).requires_grad_(True)
+    weights = torch.randn(4, 2 * SIZE, generator=torch.Generator().manual_seed(0), dtype=torch.float64)
+
+    def loss(t: torch.Tensor) -> torch.Tensor:
+        o = outline(t[None, :24], t[24:25], t[None, 25:], SIZE, CameraConfig())
+        ends = torch.stack([torch.cat([o.left[0], o.right[0]]), torch.cat([o.top[0], o.bottom[0]]),
+                            torch.cat([o.right[0], o.top[0]]), torch.cat([o.bottom[0], o.left[0]])])
+        return (torch.nan_to_num(ends) * weights).sum()
+
+    loss(theta).backward()
+    for i in (3, 12, 24, 25, 26, 27, 28):  # radii, height, pitch, roll, tx, ty
+        step = torch.zeros_like(theta)
+        step[i] = 1e-7  # small: lines that start or stop meeting the object make the sum jump
+        with torch.no_grad():
+            numeric = (loss(theta + step) - loss(theta - step)) / 2e-7
+        assert float(theta.grad[i]) == pytest.approx(float(numeric), rel=1e-3, abs=1e-3), i
