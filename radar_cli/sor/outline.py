@@ -83,17 +83,35 @@ def disc_conics(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, 
 
 
 def vertical_extent(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, size: int,
-                    camera: CameraConfig = CameraConfig(), n_discs: int | None = None) -> tuple[torch.Tensor,
-                                                                                               torch.Tensor]:
-    """The silhouette's top and bottom rows in an S x S image (pixel-centre coordinates, B each): the extremes
-    of the discs' ellipses, each in closed form from its dual conic g D g^T (the horizontal lines y = c tangent
-    to it), far cheaper than the full outline. Same discs as outline()."""
-    g = disc_frames(radius, height, pose, n_discs or n_discs_for(size), camera)  # B x K x 3 x 3
-    dual = g @ UNIT_CIRCLE.to(g.device) @ g.transpose(-1, -2)
-    # line (0, 1, -c) tangent: dual_11 - 2 c dual_12 + c^2 dual_22 = 0
-    low, high = roots(dual[..., 2, 2], -dual[..., 1, 2], dual[..., 1, 1])  # B x K normalised y, up
+                    camera: CameraConfig = CameraConfig(), n_discs: int | None = None,
+                    margin: int = 3) -> tuple[torch.Tensor, torch.Tensor]:
+    """The silhouette's top and bottom rows in an S x S image, as sampled by outline() (the least of its columns'
+    tops and the greatest of their bottoms, pixel-centre coordinates; B each), computed only on the columns
+    within `margin` of the extremes: each disc's extreme is in closed form from its dual conic g D g^T (the
+    horizontal lines y = c tangent to it), which places them. Far cheaper than the full outline."""
+    n_discs = n_discs or n_discs_for(size)
+    with torch.no_grad():
+        g = disc_frames(radius, height, pose, n_discs, camera)  # B x K x 3 x 3
+        dual = g @ UNIT_CIRCLE.to(g.device) @ g.transpose(-1, -2)
+        # line l = (0, 1, -c) tangent: dual_11 - 2 c dual_12 + c^2 dual_22 = 0; it touches at dual @ l
+        low, high = roots(dual[..., 2, 2], -dual[..., 1, 2], dual[..., 1, 1])  # B x K normalised y, up
+        apex = []
+        for c, k in ((high, torch.nan_to_num(high, nan=-math.inf).argmax(1)),
+                     (low, torch.nan_to_num(low, nan=math.inf).argmin(1))):
+            rows = torch.arange(len(k), device=k.device)
+            touch = dual[rows, k, :, 1] - c[rows, k, None] * dual[rows, k, :, 2]  # B x 3
+            apex.append(touch[:, 0] / touch[:, 2])
+        columns = (torch.cat(apex) + 1.0) * (size / 2.0) - 0.5
+        columns = columns[columns.isfinite()]
+        first = max(int(columns.min().floor()) - margin, 0) if len(columns) else 0
+        last = min(int(columns.max().ceil()) + margin, size - 1) if len(columns) else size - 1
+        first, last = min(first, size - 1), max(last, min(first, size - 1))
+    q = disc_conics(radius, height, pose, n_discs, camera)
+    swap = SWAP_XY.to(q.device)
+    step = 2.0 / size
+    bottom, top = _row_ends(swap @ q @ swap, (1.0 / size - 1.0 + first * step, step, last - first + 1))
     to_row = lambda y: (1.0 - y) * (size / 2.0) - 0.5  # noqa: E731 (normalised y up -> pixel-centre row)
-    return to_row(_extreme(high, torch.amax, -math.inf)), to_row(_extreme(low, torch.amin, math.inf))
+    return (to_row(_extreme(top, torch.amax, -math.inf)), to_row(_extreme(bottom, torch.amin, math.inf)))
 
 
 def _adjugate(m: torch.Tensor) -> torch.Tensor:

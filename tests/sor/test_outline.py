@@ -58,11 +58,8 @@ def test_vertical_extent_is_the_outlines_top_and_bottom(pitch):
     radius, height, pose = _vase(pitch, 3.0, 0.04, -0.03)
     drawn = outline(radius, height, pose, SIZE, CameraConfig())
     top, bottom = vertical_extent(radius, height, pose, SIZE, CameraConfig())
-    # the outline samples the silhouette's columns at pixel centres; the extent is the exact extreme
-    assert float(top[0]) <= np.nanmin(drawn.top[0].numpy()) + 1e-9
-    assert float(top[0]) == pytest.approx(np.nanmin(drawn.top[0].numpy()), abs=0.02)
-    assert float(bottom[0]) >= np.nanmax(drawn.bottom[0].numpy()) - 1e-9
-    assert float(bottom[0]) == pytest.approx(np.nanmax(drawn.bottom[0].numpy()), abs=0.02)
+    assert float(top[0]) == pytest.approx(np.nanmin(drawn.top[0].numpy()), abs=1e-9)
+    assert float(bottom[0]) == pytest.approx(np.nanmax(drawn.bottom[0].numpy()), abs=1e-9)
 
 
 def test_outline_gradient_matches_finite_differences():
