@@ -93,8 +93,7 @@ def vertical_extent(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tens
     with torch.no_grad():
         g = disc_frames(radius, height, pose, n_discs, camera)  # B x K x 3 x 3
         dual = g @ UNIT_CIRCLE.to(g.device) @ g.transpose(-1, -2)
-        # line l = (0, 1, -c) tangent: dual_11 - 2 c dual_12 + c^2 dual_22 = 0; it touches at dual @ l
-        low, high = roots(dual[..., 2, 2], -dual[..., 1, 2], dual[..., 1, 1])  # B x K normalised y, up
+        low, high = _tangent_heights(dual)  # B x K normalised y, up; line (0, 1, -c) touches at dual @ (0, 1, -c)
         apex = []
         for c, k in ((high, torch.nan_to_num(high, nan=-math.inf).argmax(1)),
                      (low, torch.nan_to_num(low, nan=math.inf).argmin(1))):
@@ -112,6 +111,12 @@ def vertical_extent(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tens
     bottom, top = _row_ends(swap @ q @ swap, (1.0 / size - 1.0 + first * step, step, last - first + 1))
     to_row = lambda y: (1.0 - y) * (size / 2.0) - 0.5  # noqa: E731 (normalised y up -> pixel-centre row)
     return (to_row(_extreme(top, torch.amax, -math.inf)), to_row(_extreme(bottom, torch.amin, math.inf)))
+
+
+def _tangent_heights(dual: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """The lower and upper heights c of the horizontal lines y = c tangent to conics given by their duals
+    (... x 3 x 3): the line l = (0, 1, -c) is tangent iff l^T dual l = dual_11 - 2 c dual_12 + c^2 dual_22 = 0."""
+    return roots(dual[..., 2, 2], -dual[..., 1, 2], dual[..., 1, 1])
 
 
 def _adjugate(m: torch.Tensor) -> torch.Tensor:
@@ -151,14 +156,13 @@ def _row_ends(q: torch.Tensor, lines: tuple[float, float, int]) -> tuple[torch.T
     sides = ((xa, a * xa + b), (xb, a * xb + b))
     y0, dy, n = lines
     with torch.no_grad():
-        dual = _adjugate(q)  # the lines y = c tangent to an ellipse: dual_11 - 2 c dual_12 + c^2 dual_22 = 0
-        index, y = _band(*roots(dual[..., 2, 2], -dual[..., 1, 2], dual[..., 1, 1]), lines)  # B x K x W
-        crossings = _crossings(tuple(c.detach()[..., None] for c in conic), y)  # (lo, hi), B x K x W each
+        index, y = _band(*_tangent_heights(_adjugate(q)), lines)  # B x K x W
+        crossings = _crossings(tuple(c[..., None] for c in conic), y)  # (lo, hi), B x K x W each
         segments = []
         for x, ys in sides:
             seg_index, at = _band(ys[:, :-1], ys[:, 1:], lines)  # B x (K-1) x W
-            segments.append((_segment(x.detach()[:, :-1, None], x.detach()[:, 1:, None], ys.detach()[:, :-1, None],
-                                      ys.detach()[:, 1:, None], at), seg_index))
+            segments.append((_segment(x[:, :-1, None], x[:, 1:, None], ys[:, :-1, None], ys[:, 1:, None], at),
+                             seg_index))
         winners = [(_winner(crossings[i], index, n, reduce), _winner(*segments[i], n, reduce))
                    for i, reduce in enumerate(("amin", "amax"))]
     heights = y0 + torch.arange(n, device=q.device).to(q.dtype) * dy  # N
