@@ -16,10 +16,9 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 import torch
-import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig
-from radar_cli.sor.camera import project
+from radar_cli.render.texture import sample_surface
 from radar_cli.sor.surface import surface_grid
 
 
@@ -66,10 +65,7 @@ def band_coherence(detail: np.ndarray, inner: np.ndarray, radius: torch.Tensor, 
     """
     image = torch.from_numpy(np.stack([detail, inner])).to(radius.dtype)[None]  # 1 x 2 x N x N
     grid = surface_grid(radius, height, pose, cue.rows, cue.cols, camera)
-    # render.texture.unwrap's sampling, on one image shared by every candidate
-    xy = project(grid.points, camera)  # B x R x C x 2
-    tex = F.grid_sample(image.expand(len(radius), -1, -1, -1), xy, mode="bilinear", padding_mode="border",
-                        align_corners=False)  # B x 2 x R x C
+    tex = sample_surface(image, grid, camera)  # B x 2 x R x C, one image shared by every candidate
     facing = (grid.normals * grid.view).sum(-1)  # B x R x C
     usable = (tex[:, 1] > 0.999) & (facing > cue.min_facing)
     usable = usable & usable.all(0, keepdim=True)

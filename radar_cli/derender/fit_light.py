@@ -33,7 +33,7 @@ import torch.nn.functional as F
 from radar_cli.config import CameraConfig
 from radar_cli.derender.light_lobes import LobeProblem, fit_lobes
 from radar_cli.render.lighting import GAMMA, decompose, env_directions, phong_transport, tone_map
-from radar_cli.render.texture import unwrap
+from radar_cli.render.texture import sample_surface
 from radar_cli.sor.surface import surface_grid
 from radar_cli.threads import torch_threads
 
@@ -168,8 +168,8 @@ def _texels(crop: np.ndarray, silhouette: np.ndarray, geo: tuple[torch.Tensor, .
     dtype = torch.float64
     image = torch.from_numpy(np.ascontiguousarray(crop)).permute(2, 0, 1)[None].to(dtype) / 255.0
     cover = torch.from_numpy(silhouette.astype(np.float64))[None, None]
-    texture = unwrap(*geo, torch.cat([image, cover], 1), (g, g), camera)[0].reshape(4, -1)  # 4 x g*g
     grid = surface_grid(*geo, g, g, camera)
+    texture = sample_surface(torch.cat([image, cover], 1), grid, camera)[0].reshape(4, -1)  # 4 x g*g
     normals, view = grid.normals[0].reshape(-1, 3), grid.view[0].reshape(-1, 3)
     usable = (texture[3] > config.coverage) & ((normals * view).sum(-1) > config.min_facing)
     if int(usable.sum()) < 0.05 * g * g:

@@ -14,7 +14,7 @@ from radar_cli.config import CameraConfig
 from radar_cli.render.raycast import Hits
 from radar_cli.sor.camera import project
 from radar_cli.sor.profile import check_sor
-from radar_cli.sor.surface import FRONT_SPAN, surface_grid
+from radar_cli.sor.surface import FRONT_SPAN, SurfaceGrid, surface_grid
 
 
 def front_third(texture: torch.Tensor) -> torch.Tensor:
@@ -99,6 +99,20 @@ def unwrap(
     check_shape(image, "B C H W", "image", {"B": radius.shape[0]})
     check_finite(image, "image")
     rows, cols = tex_size
-    grid = surface_grid(radius, height, pose, rows, cols, camera)
+    return sample_surface(image, surface_grid(radius, height, pose, rows, cols, camera), camera)
+
+
+def sample_surface(image: torch.Tensor, grid: SurfaceGrid, camera: CameraConfig = CameraConfig()) -> torch.Tensor:
+    """The image at a surface grid's points, projected and sampled bilinearly (unwrap's sampling, for a caller
+    that also needs the grid's normals).
+
+    Args:
+        image: B x C x H x W, or 1 x C x H x W shared by every grid of the batch (not copied).
+        grid: the surface samples, B x rows x cols.
+
+    Returns:
+        B x C x rows x cols.
+    """
     xy = project(grid.points, camera)  # B x rows x cols x 2
+    image = image.expand(xy.shape[0], -1, -1, -1)
     return F.grid_sample(image, xy, mode="bilinear", padding_mode="border", align_corners=False)

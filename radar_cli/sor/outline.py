@@ -77,7 +77,12 @@ def disc_conics(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, 
     Returns:
         B x n_discs x 3 x 3 symmetric conics, each scaled to unit norm.
     """
-    adj = _adjugate(disc_frames(radius, height, pose, n_discs, camera))  # proportional to g^-1
+    return _conics(disc_frames(radius, height, pose, n_discs, camera))
+
+
+def _conics(g: torch.Tensor) -> torch.Tensor:
+    """The unit-norm point conics of the discs whose frames are g (... x 3 x 3, disc_frames)."""
+    adj = _adjugate(g)  # proportional to g^-1
     q = adj.transpose(-1, -2) @ UNIT_CIRCLE.to(adj.device) @ adj
     return q / q.flatten(-2).norm(dim=-1)[..., None, None]
 
@@ -89,9 +94,8 @@ def vertical_extent(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tens
     tops and the greatest of their bottoms, pixel-centre coordinates; B each), computed only on the columns
     within `margin` of the extremes: each disc's extreme is in closed form from its dual conic g D g^T (the
     horizontal lines y = c tangent to it), which places them. Far cheaper than the full outline."""
-    n_discs = n_discs or n_discs_for(size)
+    g = disc_frames(radius, height, pose, n_discs or n_discs_for(size), camera)  # B x K x 3 x 3
     with torch.no_grad():
-        g = disc_frames(radius, height, pose, n_discs, camera)  # B x K x 3 x 3
         dual = g @ UNIT_CIRCLE.to(g.device) @ g.transpose(-1, -2)
         low, high = _tangent_heights(dual)  # B x K normalised y, up; line (0, 1, -c) touches at dual @ (0, 1, -c)
         apex = []
@@ -105,7 +109,7 @@ def vertical_extent(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tens
         first = max(int(columns.min().floor()) - margin, 0) if len(columns) else 0
         last = min(int(columns.max().ceil()) + margin, size - 1) if len(columns) else size - 1
         first, last = min(first, size - 1), max(last, min(first, size - 1))
-    q = disc_conics(radius, height, pose, n_discs, camera)
+    q = _conics(g)
     swap = SWAP_XY.to(q.device)
     step = 2.0 / size
     bottom, top = _row_ends(swap @ q @ swap, (1.0 / size - 1.0 + first * step, step, last - first + 1))
