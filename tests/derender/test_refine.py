@@ -20,10 +20,13 @@ SIZE = 512  # the default output side, where the lip's contrast was tuned
 class Appearance:
     """Stands in for RadarModel.read_appearance: fixed lighting, material and albedo at any shape."""
 
+    def __init__(self, rho: float = 0.3):
+        self.rho = rho
+
     def read_appearance(self, image, radius, height, pose):
         b = radius.shape[0]
         return Decomposition(radius, height, pose, torch.full((b, 3, 8, 8), 0.5), torch.ones(b, 4, 12),
-                             torch.full((b,), 20.0), torch.full((b,), 0.3))
+                             torch.full((b,), 20.0), torch.full((b,), self.rho))
 
 
 def _sample(index: int):
@@ -101,3 +104,14 @@ def test_shape_only_keeps_the_re_read_lighting():
     refined, report = refine_object(Appearance(), torch.zeros(1, 3, 64, 64), start, image, mask, CameraConfig(),
                                     light=None)
     assert report.light == "" and torch.equal(refined.env, torch.ones(1, 4, 12))
+
+
+@pytest.mark.parametrize("read, kept", [(1.6, 1.0), (0.3, 0.3)])
+def test_re_read_specular_albedo_is_at_most_one(read, kept):
+    """The light head reads 0..2; a specular albedo above 1 would reflect more light than arrives."""
+    image, mask, params = _sample(0)
+    start = _perturbed(params, 2.0, 1.05)
+    refined, report = refine_object(Appearance(rho=read), torch.zeros(1, 3, 64, 64), start, image, mask,
+                                    CameraConfig(), light=None)
+    assert report.status == "refined"
+    assert float(refined.rho[0]) == pytest.approx(kept)
