@@ -19,6 +19,8 @@ COMMANDS: list[tuple[str, str, str, str]] = [
     ("masks", "radar_cli.cli.masks", "masks", "Crop photographs and make silhouettes (GrabCut), with quality scores."),
     ("synth", "radar_cli.cli.synth", "synth", "Render synthetic vases with full ground truth."),
     ("train", "radar_cli.cli.train", "train", "Train the RADAR model on a prepared or synthetic dataset."),
+    ("train-reader", "radar_cli.cli.train", "train_reader",
+     "Teach the specular-albedo reader with synthetic ground truth."),
     ("derender", "radar_cli.cli.derender", "derender", "De-render photographs into per-object folders of exports."),
     ("serve", "radar_cli.cli.serve", "serve", "Show a results folder's gallery and 3D viewer at a local address."),
     ("relight", "radar_cli.cli.relight", "relight", "Re-render a de-rendered object under new light and view."),

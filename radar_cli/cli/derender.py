@@ -61,6 +61,9 @@ RESOLUTION = ResolutionType()
               help="full: fit each object's shape and pose to its silhouette and rim at the output resolution, "
                    "re-read lighting, material and albedo there, then fit the environment map to the photo's "
                    "shading; shape: the same without the lighting fit; none: the network's prediction as it is.")
+@click.option("--specular-reader", "reader", default="bundled", show_default=True, metavar="bundled|none|FILE",
+              help="With --refine full or shape: the specular-albedo reader (`radar train-reader`) that reads it "
+                   "at the fitted shape; none: the lighting network's reading, at most 1.")
 @click.option("--views", type=click.IntRange(0, 360), default=8, show_default=True, help="Turntable frames.")
 @click.option("--resolution", type=RESOLUTION, default=str(DEFAULT_RESOLUTION), show_default=True,
               help="Side in pixels of the outputs (crop, renders, the frontal third of the maps): an integer, "
@@ -83,16 +86,16 @@ RESOLUTION = ResolutionType()
 @click.option("--contact-sheet", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Also write a contact sheet PNG (input, reconstruction, albedo, relit view per object).")
 def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks: Path | None, crop: str,
-             backdrop: str, device: str, albedo: str, pitch: str, refine: str, resolution: Resolution, views: int,
-             view_size: int | None, envs: tuple[Path, ...], batch_size: int, workers: int, threads: int,
-             overwrite: bool, shard: str, contact_sheet: Path | None) -> None:
+             backdrop: str, device: str, albedo: str, pitch: str, refine: str, reader: str, resolution: Resolution,
+             views: int, view_size: int | None, envs: tuple[Path, ...], batch_size: int, workers: int,
+             threads: int, overwrite: bool, shard: str, contact_sheet: Path | None) -> None:
     """De-render INPUTS (image files, folders, prepared dataset folders) into --out.
 
     On many processes or machines: `torchrun --nnodes N --nproc_per_node P -m radar_cli derender ...` (rank 0
     writes the report for all), or one `--shard K/N` job per share. Rerunning the same command finishes the
     objects a killed process left."""
     def load(dev: str) -> Predictor:
-        return Predictor.from_checkpoint(checkpoint, dev, albedo, pitch, refine)  # type: ignore[arg-type]
+        return Predictor.from_checkpoint(checkpoint, dev, albedo, pitch, refine, reader)  # type: ignore[arg-type]
 
     options = DerenderOptions(out=out, crop=crop, backdrop=backdrop, masks=masks,  # type: ignore[arg-type]
                               envs=envs, batch_size=batch_size, workers=workers, threads=threads, overwrite=overwrite,

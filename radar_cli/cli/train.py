@@ -51,3 +51,28 @@ def train(config_path: str, data_dir: str, run_dir: str, resume: bool, device: s
     if summary.out_of_time:  # not finished: status 3, so `radar train ... && radar derender ...` stops here
         click.echo(f"stopped by --max-minutes at step {summary.end}; continue with --resume")
         sys.exit(OUT_OF_TIME_STATUS)
+
+
+@click.command("train-reader")
+@click.option("--config", "config_path", default=None, type=click.Path(dir_okay=False),
+              help="Reader TOML (pipelines/readers/specular_albedo.toml; default: its defaults).")
+@click.option("--data", "data_dir", required=True, type=click.Path(file_okay=False),
+              help="`radar synth` dataset: train/<id>/image.png + params.json (and test/, scored each epoch).")
+@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False),
+              help="Run folder: specular_reader.safetensors, last.safetensors (resumed from), loss.png.")
+@click.option("--checkpoint", "base", default=None, type=click.Path(dir_okay=False),
+              help="Model whose f_L the reader starts from (default: the bundled model).")
+def train_reader(config_path: str | None, data_dir: str, out_dir: str, base: str | None) -> None:
+    """Teach the specular-albedo reader that `radar derender --refine` uses, from a model's f_L."""
+    from radar_cli.config import load_toml
+    from radar_cli.derender.predictor import bundled_checkpoint
+    from radar_cli.train.specular_reader import ReaderConfig, train_reader as run
+
+    config = load_toml(ReaderConfig, config_path) if config_path else ReaderConfig()
+    summary = run(config, data_dir, out_dir, base or bundled_checkpoint())
+    for r in summary.history:
+        held = (f", held out {r['held_out_l1']:.4f} (best constant {r['held_out_constant_l1']:.4f})"
+                if "held_out_l1" in r else "")
+        click.echo(f"epoch {r['step']}: train L1 {r['train_l1']:.4f}{held}")
+    resumed = f", resumed after epoch {summary.resumed}" if summary.resumed else ""
+    click.echo(f"reader: {summary.reader} ({summary.seconds:.1f} s{resumed})")

@@ -19,9 +19,12 @@ from radar_cli.derender.refine import REFINE_MODES, RefineMode, RefineReport, re
 from radar_cli.errors import CheckpointError, InputError
 from radar_cli.model.outputs import Decomposition
 from radar_cli.model.radar import RadarModel
+from radar_cli.model.specular_reader import SpecularReader
 from radar_cli.render.scene import divide_shading, shade
 
 ASSETS = Path(__file__).resolve().parents[1] / "assets"
+READER_ASSET = "readers/specular_albedo.safetensors"  # the bundled reader (pipelines/readers/specular_albedo.toml)
+BUNDLED, NO_READER = "bundled", "none"  # --specular-reader's named values
 AlbedoSource = Literal["network", "divided"]
 ALBEDO_SOURCES: tuple[AlbedoSource, ...] = ("network", "divided")
 PitchSource = Literal["network", "search"]
@@ -34,6 +37,20 @@ def bundled_checkpoint() -> Path:
     if not found:
         raise CheckpointError(f"{ASSETS}: no bundled model (*.safetensors) found; pass --checkpoint PATH")
     return found[0]
+
+
+def load_reader(reader: str | Path, camera: CameraConfig, device: torch.device) -> SpecularReader | None:
+    """The specular-albedo reader `reader` names (a file, `bundled`, or `none`: None), in eval mode on `device`;
+    CheckpointError if it is unreadable or was trained for another camera than the model's."""
+    if str(reader) == NO_READER:
+        return None
+    path = ASSETS / READER_ASSET if str(reader) == BUNDLED else Path(reader)
+    from radar_cli.train.checkpoint import load_specular_reader
+
+    loaded = load_specular_reader(path, device)
+    if loaded.config.camera != camera:
+        raise CheckpointError(f"{path}: the reader was trained with another camera than the model's")
+    return loaded
 
 
 def resolve_device(name: str) -> torch.device:
@@ -78,11 +95,12 @@ class Predictor:
         refine: `full`: each object's shape and pose fitted at the output resolution, f_L and f_A re-read
             there, and the environment map fitted to the crop's shading (derender.refine; needs a RadarModel);
             `shape`: the same without the lighting fit; `none`: the network's prediction as it is.
+        reader: reads the specular albedo at the refined shape (model.specular_reader; None: f_L's re-reading).
     """
 
     def __init__(self, model: Callable[[torch.Tensor], Decomposition], setup: ModelSetup, version: str,
                  device: torch.device | str = "cpu", albedo: AlbedoSource = "divided",
-                 pitch: PitchSource = "network", refine: RefineMode = "none"):
+                 pitch: PitchSource = "network", refine: RefineMode = "none", reader: SpecularReader | None = None):
         if albedo not in ALBEDO_SOURCES:
             raise InputError(f"unknown albedo source {albedo!r} (use {' or '.join(ALBEDO_SOURCES)})")
         if pitch not in PITCH_SOURCES:
@@ -99,12 +117,14 @@ class Predictor:
         self.albedo = albedo
         self.pitch = pitch
         self.refine = refine
+        self.reader = reader
 
     @classmethod
     def from_checkpoint(cls, path: str | Path | None = None, device: str = "auto",
                         albedo: AlbedoSource = "divided", pitch: PitchSource = "network",
-                        refine: RefineMode = "none") -> "Predictor":
-        """Load a checkpoint (default: the bundled model); CheckpointError if it is missing or does not fit."""
+                        refine: RefineMode = "none", reader: str | Path = BUNDLED) -> "Predictor":
+        """Load a checkpoint (default: the bundled model) and, when refining, a specular-albedo reader (`reader`:
+        a file, `bundled`, or `none` for f_L's reading); CheckpointError if either is missing or does not fit."""
         path = Path(path) if path is not None else bundled_checkpoint()
         if not path.is_file():
             raise CheckpointError(f"{path}: no such checkpoint")
@@ -117,7 +137,8 @@ class Predictor:
         model.eval()
         cfg = model.config
         setup = ModelSetup(cfg.render, cfg.camera, cfg.geometry)
-        return cls(model, setup, f"{path.name}#{_short_hash(path)}", dev, albedo, pitch, refine)
+        specular = None if refine == "none" else load_reader(reader, cfg.camera, dev)
+        return cls(model, setup, f"{path.name}#{_short_hash(path)}", dev, albedo, pitch, refine, specular)
 
     @torch.no_grad()
     def predict(self, images: list[np.ndarray],
@@ -169,7 +190,7 @@ class Predictor:
         batch = torch.from_numpy(image).permute(2, 0, 1)[None].to(self.device, torch.float32) / 255.0
         light = LightFitConfig() if self.refine == "full" else None
         refined, report = refine_object(self.model, batch, dec.to(self.device), crop, silhouette,
-                                        self.setup.camera, light=light)
+                                        self.setup.camera, light=light, reader=self.reader)
         return (dec if refined is None else refined.to("cpu")), report
 
     def _search_pitch(self, batch: torch.Tensor, silhouettes: list[np.ndarray | None],

@@ -1,6 +1,7 @@
 """Per-object refinement after the network (`radar derender --refine full`, the default): the shape and pose
 fitted to the silhouette and the rim at the crop's resolution (derender.fit_shape), the lighting, material and
-albedo networks re-read at the fitted shape (the specular albedo held at most 1), then the environment map fitted to the photograph's shading there
+albedo networks re-read at the fitted shape, the specular albedo read there by the specular-albedo reader
+(model.specular_reader; or f_L's, held at most 1), then the environment map fitted to the photograph's shading there
 (derender.fit_light). A shape fit that fails, or draws the outline worse than the network's prediction, falls back
 to the network's and says why (material.json `refine`, summary.csv); a lighting fit with too few usable texels
 keeps the network's map. `--refine shape` stops after the re-reading."""
@@ -19,6 +20,7 @@ from radar_cli.config import CameraConfig
 from radar_cli.derender.fit_light import LightFitConfig, fit_environment
 from radar_cli.derender.fit_shape import ShapeFitConfig, fit_shape, outline_score
 from radar_cli.masks.refine import iou
+from radar_cli.model.specular_reader import SpecularReader
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.raycast import cast_rays
 from radar_cli.sor.outline import mask_outline, outline
@@ -28,7 +30,7 @@ RefineMode = Literal["full", "shape", "none"]
 REFINE_MODES: tuple[RefineMode, ...] = ("full", "shape", "none")
 FIT_ERRORS = (ValueError, RuntimeError, FloatingPointError)
 MAX_SPECULAR_ALBEDO = 1.0  # the normalised Phong lobe reflects rho of the light arriving: above 1 it would make
-# light (the network's head reads 0..2); the cap lowers the specular albedo's error on every synthetic set measured
+# light (f_L's head reads 0..2); the cap lowers f_L's specular albedo error on every synthetic set measured
 
 
 @dataclass(frozen=True)
@@ -44,6 +46,8 @@ class RefineReport:
         outline_px: mean distance between the drawn and the located outline (px at `resolution`), refined /
             network.
         iou: silhouette IoU against the located one at `resolution`, refined / network.
+        specular: where the specular albedo comes from: `reader` (the specular-albedo reader at the fitted
+            shape, model.specular_reader), `network` (f_L's re-reading, at most 1) or '' (no shape fit).
         light: `fitted` (the environment map fitted to the shading), `kept` (the network's map: too few texels
             were usable) or '' (not run: `--refine shape`, or no shape fit).
         light_rmse: the paints' model against the unwrapped texture (display levels), fitted / network map (a
@@ -58,6 +62,7 @@ class RefineReport:
     pitch_cue: str = ""
     outline_px: tuple[float, float] = (float("nan"), float("nan"))
     iou: tuple[float, float] = (float("nan"), float("nan"))
+    specular: str = ""
     light: str = ""
     light_rmse: tuple[float, float] = (float("nan"), float("nan"))
     seconds: float = 0.0
@@ -70,7 +75,7 @@ class RefineReport:
                 "pitch_cue": self.pitch_cue, "outline_px": {"refined": clean(self.outline_px[0]),
                                                             "network": clean(self.outline_px[1])},
                 "silhouette_iou": {"refined": clean(self.iou[0]), "network": clean(self.iou[1])},
-                "light": self.light, "light_rmse": {"fitted": clean(self.light_rmse[0]),
+                "specular_albedo": self.specular, "light": self.light, "light_rmse": {"fitted": clean(self.light_rmse[0]),
                                                     "network": clean(self.light_rmse[1])}}
 
 
@@ -85,7 +90,8 @@ def silhouette_iou(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tenso
 
 def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarray, silhouette: np.ndarray | None,
                   camera: CameraConfig, config: ShapeFitConfig = ShapeFitConfig(),
-                  light: LightFitConfig | None = LightFitConfig()) -> tuple[Decomposition | None, RefineReport]:
+                  light: LightFitConfig | None = LightFitConfig(),
+                  reader: SpecularReader | None = None) -> tuple[Decomposition | None, RefineReport]:
     """Refine one object's prediction.
 
     Args:
@@ -95,6 +101,7 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
             nothing to fit, the network's prediction is kept).
         camera: the fixed camera. config, light: the shape and the lighting fits' settings (light None: no
             lighting fit, the networks' re-reading is kept).
+        reader: reads the specular albedo at the fitted shape (None: f_L's re-reading, at most 1).
 
     Returns:
         (the refined Decomposition with config.rows profile rows, or None to keep `dec`; the report).
@@ -124,8 +131,11 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
                                                f"against the network's {network_iou:.3f})")
     device = image.device
     with torch.no_grad():
-        refined = model.read_appearance(image, fit.radius.to(device), fit.height.to(device), fit.pose.to(device))
-    refined = dataclasses.replace(refined.detach(), rho=refined.rho.detach().clamp(max=MAX_SPECULAR_ALBEDO))
+        geo = (fit.radius.to(device), fit.height.to(device), fit.pose.to(device))
+        refined = model.read_appearance(image, *geo).detach()
+        rho = refined.rho.clamp(max=MAX_SPECULAR_ALBEDO) if reader is None else reader(image, *geo)
+    refined = dataclasses.replace(refined, rho=rho)
+    report = dataclasses.replace(report, specular="network" if reader is None else "reader")
     if light is not None:
         refined, report = _fit_light(refined, dec.env, crop, silhouette, camera, light, report)
     return refined, dataclasses.replace(report, seconds=time.perf_counter() - start)

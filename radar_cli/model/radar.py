@@ -35,16 +35,8 @@ class RadarModel(nn.Module):
 
     def unwrap_inputs(self, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
                       image: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        """The inputs of f_A and f_L: the frontal texture unwrapped with the given shape and its normals.
-
-        Returns:
-            texture B x 3 x Ht x Wt (as the image, tone-mapped), normals B x 3 x Ht x Wt (camera space).
-        """
-        c = self.config
-        size = (c.render.tex_height, c.render.tex_width)
-        texture = unwrap(radius, height, pose, image, size, c.camera)
-        grid = surface_grid(radius, height, pose, size[0], size[1], c.camera)
-        return texture, grid.normals.permute(0, 3, 1, 2)  # B x 3 x Ht x Wt
+        """The inputs of f_A and f_L (frontal_inputs at this model's sizes and camera)."""
+        return frontal_inputs(self.config, radius, height, pose, image)
 
     def forward(self, image: torch.Tensor) -> Decomposition:
         """De-render a batch.
@@ -74,3 +66,20 @@ class RadarModel(nn.Module):
         env, alpha, rho = self.light_net(texture, normals)
         albedo = self.albedo_net(texture)
         return Decomposition(radius, height, pose, albedo, env, alpha, rho)
+
+
+def frontal_inputs(config: ModelConfig, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
+                   image: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """The frontal texture unwrapped from `image` with the given shape and pose, and its normals, at the texture
+    size and camera of `config`.
+
+    Args:
+        image: B x 3 x H x W. radius: B x L; height: B; pose: B x 4.
+
+    Returns:
+        texture B x 3 x Ht x Wt (as the image, tone-mapped), normals B x 3 x Ht x Wt (camera space).
+    """
+    size = (config.render.tex_height, config.render.tex_width)
+    texture = unwrap(radius, height, pose, image, size, config.camera)
+    grid = surface_grid(radius, height, pose, size[0], size[1], config.camera)
+    return texture, grid.normals.permute(0, 3, 1, 2)  # B x 3 x Ht x Wt

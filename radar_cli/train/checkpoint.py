@@ -20,12 +20,15 @@ from safetensors import SafetensorError
 from safetensors.torch import load_file, save_file
 from torch import nn
 
+from radar_cli.config import from_dict
 from radar_cli.errors import CheckpointError, ConfigError
 from radar_cli.fileio import atomic_path
-from radar_cli.model.config import RunConfig, run_config_from_dict, to_dict
+from radar_cli.model.config import ModelConfig, RunConfig, run_config_from_dict, to_dict
 from radar_cli.model.radar import RadarModel
+from radar_cli.model.specular_reader import SpecularReader
 
 FORMAT = "radar-checkpoint-1"
+READER_FORMAT = "radar-specular-reader-1"  # a SpecularReader's weights, its ModelConfig and training record
 CHECKPOINT_DIR = "checkpoints"
 _NAME_RE = re.compile(r"^step_(\d{7,})\.safetensors$")
 MODEL_FILE = "model.safetensors"  # RUN_DIR/model.safetensors: weights + config only, written when a run completes
@@ -42,7 +45,7 @@ class TrainState:
     opt_disc: torch.optim.Optimizer
 
 
-def _optimizer_tensors(opt: torch.optim.Optimizer, prefix: str) -> tuple[dict[str, torch.Tensor], str]:
+def optimizer_tensors(opt: torch.optim.Optimizer, prefix: str) -> tuple[dict[str, torch.Tensor], str]:
     """Flatten an optimizer state_dict into named tensors plus JSON for its param groups."""
     sd = opt.state_dict()
     tensors = {}
@@ -53,7 +56,7 @@ def _optimizer_tensors(opt: torch.optim.Optimizer, prefix: str) -> tuple[dict[st
     return tensors, json.dumps(sd["param_groups"])
 
 
-def _restore_optimizer(opt: torch.optim.Optimizer, tensors: dict[str, torch.Tensor], groups: str,
+def restore_optimizer(opt: torch.optim.Optimizer, tensors: dict[str, torch.Tensor], groups: str,
                        prefix: str) -> None:
     state: dict[int, dict[str, torch.Tensor]] = {}
     for key, value in tensors.items():
@@ -63,11 +66,11 @@ def _restore_optimizer(opt: torch.optim.Optimizer, tensors: dict[str, torch.Tens
     opt.load_state_dict({"state": state, "param_groups": json.loads(groups)})
 
 
-def _module_tensors(module: nn.Module, prefix: str) -> dict[str, torch.Tensor]:
+def module_tensors(module: nn.Module, prefix: str) -> dict[str, torch.Tensor]:
     return {f"{prefix}.{k}": v.detach().cpu().contiguous() for k, v in module.state_dict().items()}
 
 
-def _load_module(module: nn.Module, tensors: dict[str, torch.Tensor], prefix: str, path: Path) -> None:
+def load_module(module: nn.Module, tensors: dict[str, torch.Tensor], prefix: str, path: Path) -> None:
     sub = {k[len(prefix) + 1 :]: v for k, v in tensors.items() if k.startswith(prefix + ".")}
     try:
         module.load_state_dict(sub, strict=True)
@@ -78,9 +81,9 @@ def _load_module(module: nn.Module, tensors: dict[str, torch.Tensor], prefix: st
 
 def save_checkpoint(run_dir: str | Path, config: RunConfig, state: TrainState, keep: int) -> Path:
     """Write RUN_DIR/checkpoints/step_<step>.safetensors atomically and delete all but the newest `keep`."""
-    tensors = _module_tensors(state.model, "model") | _module_tensors(state.disc, "disc")
-    opt_m, groups_m = _optimizer_tensors(state.opt_model, "opt_model")
-    opt_d, groups_d = _optimizer_tensors(state.opt_disc, "opt_disc")
+    tensors = module_tensors(state.model, "model") | module_tensors(state.disc, "disc")
+    opt_m, groups_m = optimizer_tensors(state.opt_model, "opt_model")
+    opt_d, groups_d = optimizer_tensors(state.opt_disc, "opt_disc")
     meta = {"format": FORMAT, "config": json.dumps(to_dict(config)), "step": str(state.step),
             "opt_model_groups": groups_m, "opt_disc_groups": groups_d}
     path = Path(run_dir) / CHECKPOINT_DIR / f"step_{state.step:07d}.safetensors"
@@ -106,6 +109,22 @@ def read_checkpoint(path: str | Path) -> tuple[dict[str, torch.Tensor], dict[str
     Raises:
         CheckpointError: missing, truncated or corrupt file, foreign format, or an invalid stored config.
     """
+    tensors, meta = read_weights(path, FORMAT)
+    try:
+        config = run_config_from_dict(json.loads(meta["config"]))
+    except (KeyError, ValueError, ConfigError) as e:
+        raise CheckpointError(f"{path}: stored config is invalid ({e})") from None
+    return tensors, meta, config
+
+
+def read_weights(path: str | Path, expected_format: str,
+                 kind: str = "radar checkpoint") -> tuple[dict[str, torch.Tensor], dict[str, str]]:
+    """Tensors and metadata of a safetensors file whose metadata names `expected_format` (never unpickles);
+    `kind` names such a file in errors.
+
+    Raises:
+        CheckpointError: missing, truncated or corrupt file, or another format.
+    """
     path = Path(path)
     if not path.is_file():
         raise CheckpointError(f"{path}: no such checkpoint")
@@ -117,13 +136,9 @@ def read_checkpoint(path: str | Path) -> tuple[dict[str, torch.Tensor], dict[str
         tensors = load_file(str(path))
     except (SafetensorError, OSError, ValueError, RuntimeError) as e:
         raise CheckpointError(f"{path}: corrupt or not a safetensors checkpoint ({e})") from None
-    if meta.get("format") != FORMAT:
-        raise CheckpointError(f"{path}: not a radar checkpoint (format {meta.get('format')!r}, expected {FORMAT})")
-    try:
-        config = run_config_from_dict(json.loads(meta["config"]))
-    except (KeyError, ValueError, ConfigError) as e:
-        raise CheckpointError(f"{path}: stored config is invalid ({e})") from None
-    return tensors, meta, config
+    if meta.get("format") != expected_format:
+        raise CheckpointError(f"{path}: not a {kind} (format {meta.get('format')!r}, expected {expected_format})")
+    return tensors, meta
 
 
 def restore(path: str | Path, config: RunConfig, state: TrainState) -> int:
@@ -137,11 +152,11 @@ def restore(path: str | Path, config: RunConfig, state: TrainState) -> int:
         if to_dict(getattr(stored, part)) != to_dict(getattr(config, part)):
             raise CheckpointError(f"{path}: its [{part}] config differs from the one given; resume with the same "
                                   "config or start a new run folder")
-    _load_module(state.model, tensors, "model", Path(path))
-    _load_module(state.disc, tensors, "disc", Path(path))
+    load_module(state.model, tensors, "model", Path(path))
+    load_module(state.disc, tensors, "disc", Path(path))
     try:
-        _restore_optimizer(state.opt_model, tensors, meta["opt_model_groups"], "opt_model")
-        _restore_optimizer(state.opt_disc, tensors, meta["opt_disc_groups"], "opt_disc")
+        restore_optimizer(state.opt_model, tensors, meta["opt_model_groups"], "opt_model")
+        restore_optimizer(state.opt_disc, tensors, meta["opt_disc_groups"], "opt_disc")
         state.step = int(meta["step"])
     except (KeyError, ValueError) as e:
         raise CheckpointError(f"{path}: optimizer state is missing or does not fit ({e})") from None
@@ -158,10 +173,10 @@ def initialise(path: str | Path, state: TrainState) -> bool:
         CheckpointError: corrupt file, or weights that do not fit the model being trained.
     """
     tensors, _, _ = read_checkpoint(path)
-    _load_module(state.model, tensors, "model", Path(path))
+    load_module(state.model, tensors, "model", Path(path))
     if not any(k.startswith("disc.") for k in tensors):
         return False
-    _load_module(state.disc, tensors, "disc", Path(path))
+    load_module(state.disc, tensors, "disc", Path(path))
     return True
 
 
@@ -183,5 +198,38 @@ def load_model(path: str | Path, device: str | torch.device = "cpu") -> tuple[Ra
     """
     tensors, _, config = read_checkpoint(path)
     model = RadarModel(config.model)
-    _load_module(model, tensors, "model", Path(path))
+    load_module(model, tensors, "model", Path(path))
     return model.to(device).eval(), config
+
+
+def save_specular_reader(reader: SpecularReader, path: str | Path, extra: dict[str, torch.Tensor] | None = None,
+                         meta: dict[str, str] | None = None) -> Path:
+    """Write a SpecularReader's weights (and `extra` tensors, e.g. its optimizer's) with its config, atomically."""
+    tensors = {**module_tensors(reader, "reader"), **(extra or {})}
+    with atomic_path(path) as tmp:
+        save_file(tensors, str(tmp), metadata={"format": READER_FORMAT, "config": json.dumps(to_dict(reader.config)),
+                                               **(meta or {})})
+    return Path(path)
+
+
+def read_specular_reader(path: str | Path) -> tuple[SpecularReader, dict[str, torch.Tensor], dict[str, str]]:
+    """A SpecularReader (train mode, CPU) from its file, with the file's tensors and metadata.
+
+    Raises:
+        CheckpointError: missing or corrupt file, another format, or weights that do not fit the stored config.
+    """
+    tensors, meta = read_weights(path, READER_FORMAT, "radar specular-albedo reader")
+    try:
+        config = from_dict(ModelConfig, json.loads(meta["config"]), "reader config")
+        config.validate()
+    except (KeyError, ValueError, ConfigError) as e:
+        raise CheckpointError(f"{path}: stored config is invalid ({e})") from None
+    reader = SpecularReader(config)
+    load_module(reader, tensors, "reader", Path(path))
+    return reader, tensors, meta
+
+
+def load_specular_reader(path: str | Path, device: str | torch.device = "cpu") -> SpecularReader:
+    """A SpecularReader in eval mode from its file (CheckpointError as read_specular_reader)."""
+    reader, _, _ = read_specular_reader(path)
+    return reader.to(device).eval()

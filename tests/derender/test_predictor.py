@@ -112,3 +112,18 @@ def test_checkpoint_from_another_config_is_one_clear_error(tmp_path: Path) -> No
 def test_missing_checkpoint(tmp_path: Path) -> None:
     with pytest.raises(CheckpointError, match="no such checkpoint"):
         Predictor.from_checkpoint(tmp_path / "nope.safetensors", "cpu")
+
+
+def test_missing_specular_reader_is_one_clear_error(tmp_path: Path) -> None:
+    path = save_weights(tmp_path / "model.safetensors", tiny_config(4))
+    with pytest.raises(CheckpointError, match="nope.safetensors"):
+        Predictor.from_checkpoint(path, "cpu", refine="shape", reader=tmp_path / "nope.safetensors")
+    assert Predictor.from_checkpoint(path, "cpu", refine="none", reader=tmp_path / "nope.safetensors").reader is None
+    assert Predictor.from_checkpoint(path, "cpu", refine="shape", reader="none").reader is None
+    assert Predictor.from_checkpoint(path, "cpu", refine="shape").reader is not None  # the bundled one
+    write_photo(tmp_path / "in" / "a.png", 1, (80, 80))
+    result = CliRunner().invoke(cli, ["derender", str(tmp_path / "in"), "--out", str(tmp_path / "out"),
+                                      "--checkpoint", str(path), "--specular-reader", str(tmp_path / "nope.safetensors")])
+    assert result.exit_code == 2
+    (line,) = result.output.strip().splitlines()
+    assert line.startswith("Error: ") and "nope.safetensors" in line

@@ -108,10 +108,25 @@ def test_shape_only_keeps_the_re_read_lighting():
 
 @pytest.mark.parametrize("read, kept", [(1.6, 1.0), (0.3, 0.3)])
 def test_re_read_specular_albedo_is_at_most_one(read, kept):
-    """The light head reads 0..2; a specular albedo above 1 would reflect more light than arrives."""
+    """Without a reader: f_L reads 0..2; a specular albedo above 1 would reflect more light than arrives."""
     image, mask, params = _sample(0)
     start = _perturbed(params, 2.0, 1.05)
     refined, report = refine_object(Appearance(rho=read), torch.zeros(1, 3, 64, 64), start, image, mask,
                                     CameraConfig(), light=None)
-    assert report.status == "refined"
+    assert report.status == "refined" and report.record()["specular_albedo"] == "network"
     assert float(refined.rho[0]) == pytest.approx(kept)
+
+
+def test_the_reader_reads_the_specular_albedo_at_the_fitted_shape():
+    image, mask, params = _sample(0)
+    start = _perturbed(params, 2.0, 1.05)
+    seen = []
+
+    def reader(network_input, radius, height, pose):
+        seen.append(float(pose[0, 0]))
+        return torch.tensor([0.42])
+
+    refined, report = refine_object(Appearance(rho=1.6), torch.zeros(1, 3, 64, 64), start, image, mask,
+                                    CameraConfig(), light=None, reader=reader)
+    assert report.record()["specular_albedo"] == "reader" and float(refined.rho[0]) == pytest.approx(0.42)
+    assert seen == [pytest.approx(float(refined.pose[0, 0]))]  # read at the refined pose, not the network's
