@@ -15,9 +15,10 @@ lobe counts. The photograph pins the light only loosely, and the fits disagree w
 the mean of their maps. It keeps the starting map's mean, since the albedo's brightness and the light's cannot
 be told apart.
 
-Only the environment map is refined. Shininess and specular albedo are not: with the map unknown, a sharper light
-and a lower shininess, or a brighter light in the highlight's direction and a lower specular albedo, draw the
-same photograph (docs/refinement.md measures it).
+Only the environment map is fitted here; shininess and specular albedo are held at what the caller read
+(derender.refine: f_L's shininess, the specular-albedo reader's specular albedo). With the map unknown, a sharper
+light and a lower shininess, or a brighter light in the highlight's direction and a lower specular albedo, draw
+the same photograph (docs/refinement.md measures it).
 """
 
 from __future__ import annotations
