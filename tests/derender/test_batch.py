@@ -111,7 +111,7 @@ def test_gallery_and_summary(results: Path) -> None:
 @pytest.fixture
 def fake_checkpoint(monkeypatch, predictor: Predictor) -> None:
     monkeypatch.setattr(Predictor, "from_checkpoint",
-                        classmethod(lambda cls, path, device, albedo, pitch, refine="none": predictor))
+                        classmethod(lambda cls, path, device, albedo, pitch, refine="none", reader="bundled": predictor))
 
 
 def test_cli_bad_inputs_one_line_each(tmp_path: Path, fake_checkpoint) -> None:
