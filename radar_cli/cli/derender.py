@@ -59,8 +59,9 @@ RESOLUTION = ResolutionType()
                    "photo and its silhouette, searched over the range (slower).")
 @click.option("--refine", type=click.Choice(REFINE_MODES), default="full", show_default=True,
               help="full: fit each object's shape and pose to its silhouette and rim at the output resolution, "
-                   "re-read lighting, material and albedo there, then fit the environment map to the photo's "
-                   "shading; shape: the same without the lighting fit; none: the network's prediction as it is.")
+                   "re-read lighting, material and albedo there (the specular albedo with --specular-reader), then "
+                   "fit the environment map to the photo's shading; shape: the same without the lighting fit; "
+                   "none: the network's prediction as it is.")
 @click.option("--specular-reader", "reader", default="bundled", show_default=True, metavar="bundled|none|FILE",
               help="With --refine full or shape: the specular-albedo reader (`radar train-reader`) that reads it "
                    "at the fitted shape; none: the lighting network's reading, at most 1.")

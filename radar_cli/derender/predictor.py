@@ -39,12 +39,17 @@ def bundled_checkpoint() -> Path:
     return found[0]
 
 
+def reader_path(reader: str | Path) -> Path:
+    """The file --specular-reader names: the bundled reader for `bundled`, else the path given."""
+    return ASSETS / READER_ASSET if str(reader) == BUNDLED else Path(reader)
+
+
 def load_reader(reader: str | Path, camera: CameraConfig, device: torch.device) -> SpecularReader | None:
     """The specular-albedo reader `reader` names (a file, `bundled`, or `none`: None), in eval mode on `device`;
     CheckpointError if it is unreadable or was trained for another camera than the model's."""
     if str(reader) == NO_READER:
         return None
-    path = ASSETS / READER_ASSET if str(reader) == BUNDLED else Path(reader)
+    path = reader_path(reader)
     from radar_cli.train.checkpoint import load_specular_reader
 
     loaded = load_specular_reader(path, device)
@@ -138,7 +143,10 @@ class Predictor:
         cfg = model.config
         setup = ModelSetup(cfg.render, cfg.camera, cfg.geometry)
         specular = None if refine == "none" else load_reader(reader, cfg.camera, dev)
-        return cls(model, setup, f"{path.name}#{_short_hash(path)}", dev, albedo, pitch, refine, specular)
+        version = f"{path.name}#{_short_hash(path)}"
+        if specular is not None:
+            version += f" + {reader_path(reader).name}#{_short_hash(reader_path(reader))}"
+        return cls(model, setup, version, dev, albedo, pitch, refine, specular)
 
     @torch.no_grad()
     def predict(self, images: list[np.ndarray],

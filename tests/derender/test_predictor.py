@@ -120,7 +120,8 @@ def test_missing_specular_reader_is_one_clear_error(tmp_path: Path) -> None:
         Predictor.from_checkpoint(path, "cpu", refine="shape", reader=tmp_path / "nope.safetensors")
     assert Predictor.from_checkpoint(path, "cpu", refine="none", reader=tmp_path / "nope.safetensors").reader is None
     assert Predictor.from_checkpoint(path, "cpu", refine="shape", reader="none").reader is None
-    assert Predictor.from_checkpoint(path, "cpu", refine="shape").reader is not None  # the bundled one
+    bundled = Predictor.from_checkpoint(path, "cpu", refine="shape")
+    assert bundled.reader is not None and " + specular_albedo.safetensors#" in bundled.version  # material.json
     write_photo(tmp_path / "in" / "a.png", 1, (80, 80))
     result = CliRunner().invoke(cli, ["derender", str(tmp_path / "in"), "--out", str(tmp_path / "out"),
                                       "--checkpoint", str(path), "--specular-reader", str(tmp_path / "nope.safetensors")])
