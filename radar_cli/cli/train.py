@@ -69,10 +69,6 @@ def train_reader(config_path: str | None, data_dir: str, out_dir: str, base: str
     from radar_cli.train.specular_reader import ReaderConfig, train_reader as run
 
     config = load_toml(ReaderConfig, config_path) if config_path else ReaderConfig()
-    summary = run(config, data_dir, out_dir, base or bundled_checkpoint())
-    for r in summary.history:
-        held = (f", held out {r['held_out_l1']:.4f} (best constant {r['held_out_constant_l1']:.4f})"
-                if "held_out_l1" in r else "")
-        click.echo(f"epoch {r['step']}: train L1 {r['train_l1']:.4f}{held}")
+    summary = run(config, data_dir, out_dir, base or bundled_checkpoint(), say=click.echo)
     resumed = f", resumed after epoch {summary.resumed}" if summary.resumed else ""
     click.echo(f"reader: {summary.reader} ({summary.seconds:.1f} s{resumed})")

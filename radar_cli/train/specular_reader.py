@@ -16,12 +16,13 @@ import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import torch
 from tqdm import tqdm
 
 from radar_cli.config import to_dict
-from radar_cli.errors import CheckpointError, InputError
+from radar_cli.errors import CheckpointError, ConfigError, InputError
 from radar_cli.fileio import write_image
 from radar_cli.model.specular_reader import SpecularReader
 from radar_cli.threads import torch_threads
@@ -54,6 +55,16 @@ class ReaderConfig:
     seed: int = 0
     limit: int = 0
     threads: int = 2
+
+    def validate(self) -> "ReaderConfig":
+        """ConfigError for a value no run can use."""
+        for name in ("epochs", "batch_size", "threads"):
+            if getattr(self, name) < 1:
+                raise ConfigError(f"reader config: {name} must be >= 1, got {getattr(self, name)}")
+        if not self.lr > 0 or self.limit < 0 or self.seed < 0:
+            raise ConfigError(f"reader config: lr must be > 0 and limit, seed >= 0 (got {self.lr}, {self.limit}, "
+                              f"{self.seed})")
+        return self
 
 
 @dataclass(frozen=True)
@@ -111,14 +122,16 @@ class _Split:
 
 
 def train_reader(config: ReaderConfig, data_dir: str | Path, out_dir: str | Path, base: str | Path,
-                 progress: bool | None = None) -> ReaderSummary:
+                 progress: bool | None = None, say: Callable[[str], None] = lambda line: None) -> ReaderSummary:
     """Train the reader from the f_L of the model in `base` (a checkpoint or exported model) on
-    data_dir/train/<id>/{image.png, params.json}; resumes from out_dir/last.safetensors when it is there.
+    data_dir/train/<id>/{image.png, params.json}; resumes from out_dir/last.safetensors when it is there. A bar
+    shows the steps on a terminal (`progress`); `say` gets one line per finished epoch.
 
     Raises:
         InputError: no samples, or samples without ground truth. CheckpointError: `base` or the run's last file
             is unreadable, or the last file was trained from another model.
     """
+    config.validate()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     start_time = time.perf_counter()
@@ -151,6 +164,7 @@ def train_reader(config: ReaderConfig, data_dir: str | Path, out_dir: str | Path
             if held_out is not None:
                 record["held_out_l1"], record["held_out_constant_l1"] = held_out.score(reader, config.batch_size)
             history.append(record)
+            say(epoch_line(record))
             tensors, groups = optimizer_tensors(opt, "opt")
             save_specular_reader(reader, out / LAST_FILE, tensors,
                                  {"epoch": str(epoch + 1), "opt_groups": groups, "history": json.dumps(history),
@@ -159,6 +173,13 @@ def train_reader(config: ReaderConfig, data_dir: str | Path, out_dir: str | Path
                                                                      "train": json.dumps(to_dict(config))})
         write_image(out / CURVE_FILE, loss_curve(history))
     return ReaderSummary(path, history, resumed, time.perf_counter() - start_time)
+
+
+def epoch_line(record: dict) -> str:
+    """One epoch's scores as a line of text."""
+    held = (f", held out {record['held_out_l1']:.4f} (best constant {record['held_out_constant_l1']:.4f})"
+            if "held_out_l1" in record else "")
+    return f"epoch {record['step']}: train L1 {record['train_l1']:.4f}{held}"
 
 
 def _resume(last: Path, reader: SpecularReader, opt: torch.optim.Optimizer) -> tuple[list[dict], int]:

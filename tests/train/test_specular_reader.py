@@ -12,7 +12,7 @@ import torch
 from safetensors.torch import save_file
 
 from radar_cli.config import to_dict
-from radar_cli.errors import CheckpointError, InputError
+from radar_cli.errors import CheckpointError, ConfigError, InputError
 from radar_cli.model.radar import RadarModel
 from radar_cli.model.specular_reader import SpecularReader
 from radar_cli.synth.generator import SynthConfig, make_sample, write_sample_folder
@@ -63,7 +63,9 @@ def test_reader_starts_as_f_l_reading():
 
 def test_reader_learns_resumes_and_repeats(synth32, base, tmp_path):
     config = ReaderConfig(epochs=6, batch_size=4, lr=1e-3, threads=1)
-    full = train_reader(config, synth32, tmp_path / "full", base, progress=False)
+    lines = []
+    full = train_reader(config, synth32, tmp_path / "full", base, progress=False, say=lines.append)
+    assert len(lines) == 6 and lines[-1].startswith("epoch 6: train L1")  # one line per epoch, as it ends
     first, last = full.history[0], full.history[-1]
     assert len(full.history) == 6 and full.resumed == 0
     assert last["train_l1"] < 0.8 * first["train_l1"]  # it learns the training vases' specular albedo
@@ -104,3 +106,8 @@ def test_samples_without_ground_truth_are_named(synth32, base, tmp_path):
     params.write_text(json.dumps({k: v for k, v in json.loads(params.read_text()).items() if k != "rho"}))
     with pytest.raises(InputError, match="000003.*rho"):
         train_reader(ReaderConfig(epochs=1, batch_size=4, threads=1), root, tmp_path / "out", base, progress=False)
+
+
+def test_unusable_settings_are_one_clear_error(synth32, base, tmp_path):
+    with pytest.raises(ConfigError, match="epochs"):
+        train_reader(ReaderConfig(epochs=0), synth32, tmp_path / "out", base, progress=False)
