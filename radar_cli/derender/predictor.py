@@ -145,7 +145,8 @@ class Predictor:
         specular = None if refine == "none" else load_reader(reader, cfg.camera, dev)
         version = f"{path.name}#{_short_hash(path)}"
         if specular is not None:
-            version += f" + {reader_path(reader).name}#{_short_hash(reader_path(reader))}"
+            read_from = reader_path(reader)
+            version += f" + {read_from.name}#{_short_hash(read_from)}"
         return cls(model, setup, version, dev, albedo, pitch, refine, specular)
 
     @torch.no_grad()

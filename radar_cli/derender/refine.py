@@ -20,8 +20,8 @@ from radar_cli.config import CameraConfig
 from radar_cli.derender.fit_light import LightFitConfig, fit_environment
 from radar_cli.derender.fit_shape import ShapeFitConfig, fit_shape, outline_score
 from radar_cli.masks.refine import iou
-from radar_cli.model.specular_reader import SpecularReader
 from radar_cli.model.outputs import Decomposition
+from radar_cli.model.specular_reader import SpecularReader
 from radar_cli.render.raycast import cast_rays
 from radar_cli.sor.outline import mask_outline, outline
 from radar_cli.threads import torch_threads
@@ -75,8 +75,8 @@ class RefineReport:
                 "pitch_cue": self.pitch_cue, "outline_px": {"refined": clean(self.outline_px[0]),
                                                             "network": clean(self.outline_px[1])},
                 "silhouette_iou": {"refined": clean(self.iou[0]), "network": clean(self.iou[1])},
-                "specular_albedo": self.specular, "light": self.light, "light_rmse": {"fitted": clean(self.light_rmse[0]),
-                                                    "network": clean(self.light_rmse[1])}}
+                "specular_albedo": self.specular, "light": self.light,
+                "light_rmse": {"fitted": clean(self.light_rmse[0]), "network": clean(self.light_rmse[1])}}
 
 
 def silhouette_iou(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, mask: np.ndarray,

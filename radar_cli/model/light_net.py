@@ -18,7 +18,7 @@ class LightNet(nn.Module):
                  env_range: tuple[float, float]):
         super().__init__()
         self.shininess_range, self.spec_albedo_range, self.env_range = shininess_range, spec_albedo_range, env_range
-        self.encoder = conv_encoder(6, tex_size, width, max_channels, latent, norm="group")
+        self.encoder = light_encoder(tex_size, width, max_channels, latent)
         n_up = levels(env_height, 2)
         ch = channels(width, n_up, max_channels)
         layers: list[nn.Module] = [nn.ConvTranspose2d(latent, ch, (2, 6), 1, 0), nn.ReLU()]  # 2 x 6
@@ -39,7 +39,17 @@ class LightNet(nn.Module):
         Returns:
             env B x He x We, alpha B (shininess), rho B (specular albedo), rescaled to their ranges.
         """
-        z = self.encoder(torch.cat([texture * 2 - 1, normals], dim=1))  # B x latent x 1 x 1
+        z = self.encoder(encoder_input(texture, normals))  # B x latent x 1 x 1
         env = rescale(self.env_decoder(z)[:, 0], *self.env_range)  # B x He x We
         s = self.material_head(z.flatten(1))
         return env, rescale(s[:, 0], *self.shininess_range), rescale(s[:, 1], *self.spec_albedo_range)
+
+
+def light_encoder(tex_size: int, width: int, max_channels: int, latent: int) -> nn.Module:
+    """f_L's GN encoder of the 6-channel (texture, normals) map (encoder_input) to a B x latent x 1 x 1 code."""
+    return conv_encoder(6, tex_size, width, max_channels, latent, norm="group")
+
+
+def encoder_input(texture: torch.Tensor, normals: torch.Tensor) -> torch.Tensor:
+    """B x 6 x Ht x Wt: the texture ([0, 1]) moved to [-1, 1], then the camera-space normals."""
+    return torch.cat([texture * 2 - 1, normals], dim=1)

@@ -12,9 +12,9 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from radar_cli.model.blocks import conv_encoder, head
+from radar_cli.model.blocks import head
 from radar_cli.model.config import ModelConfig
-from radar_cli.model.light_net import LightNet
+from radar_cli.model.light_net import LightNet, encoder_input, light_encoder
 from radar_cli.model.radar import frontal_inputs
 
 RANGE = (0.0, 1.0)  # a normalised Phong lobe with a specular albedo above 1 would send out more light than arrives
@@ -31,8 +31,8 @@ class SpecularReader(nn.Module):
         super().__init__()
         self.config = config
         r = config.render
-        self.encoder = conv_encoder(6, min(r.tex_height, r.tex_width), config.light_width, config.max_channels,
-                                    config.latent, norm="group")
+        self.encoder = light_encoder(min(r.tex_height, r.tex_width), config.light_width, config.max_channels,
+                                     config.latent)
         self.head = head(config.latent, 1)
 
     @classmethod
@@ -56,5 +56,5 @@ class SpecularReader(nn.Module):
             B specular albedo in RANGE.
         """
         texture, normals = frontal_inputs(self.config, radius, height, pose, image)
-        z = self.encoder(torch.cat([texture * 2 - 1, normals], dim=1))  # B x latent x 1 x 1
+        z = self.encoder(encoder_input(texture, normals))  # B x latent x 1 x 1
         return RANGE[0] + (RANGE[1] - RANGE[0]) * self.head(z.flatten(1))[:, 0]
