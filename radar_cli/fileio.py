@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import math
 import os
 import tempfile
 from contextlib import contextmanager
@@ -161,3 +162,32 @@ def read_image(path: str | Path, mode: str = "RGB") -> np.ndarray:
             background = Image.new("RGBA", im.size, (255, 255, 255, 255))
             im = Image.alpha_composite(background, im)
         return np.asarray(im.convert(mode)).copy()
+
+
+MAX_JSON_BYTES = 1_000_000  # result and sample records are a few kB; refuse absurd files
+
+
+def read_json(path: Path) -> dict:
+    """A JSON object from a small file; InputError naming the file otherwise."""
+    try:
+        if path.stat().st_size > MAX_JSON_BYTES:
+            raise InputError(f"{path}: larger than {MAX_JSON_BYTES} bytes")
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise InputError(f"{path}: not valid JSON ({e})") from None
+    if not isinstance(data, dict):
+        raise InputError(f"{path}: expected a JSON object")
+    return data
+
+
+def number(data: dict, key: str, path: Path, index: int | None = None) -> float:
+    """data[key] (or data[key][index]) as a finite float; InputError naming the file and key otherwise."""
+    value = data.get(key)
+    if index is not None:
+        value = value[index] if isinstance(value, list) and len(value) > index else None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        where = key if index is None else f"{key}[{index}]"
+        raise InputError(f"{path}: '{where}' must be a finite number, got {value!r}")
+    return float(value)

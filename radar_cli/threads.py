@@ -10,9 +10,13 @@ import torch
 
 @contextmanager
 def torch_threads(n: int) -> Iterator[None]:
-    """Run a block with `n` torch intra-op threads, then restore the previous setting."""
+    """Run a block with `n` torch intra-op threads (n <= 0: unchanged), then restore the previous setting.
+
+    On a shared machine fewer threads than cores is often faster: OpenMP threads spin while they wait.
+    """
     before = torch.get_num_threads()
-    torch.set_num_threads(n)
+    if n > 0:
+        torch.set_num_threads(n)
     try:
         yield
     finally:

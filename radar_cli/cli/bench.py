@@ -7,8 +7,8 @@ import json
 import click
 
 from radar_cli.cli.derender import RESOLUTION
-from radar_cli.derender.inputs import DEFAULT_RESOLUTION, Resolution
-from radar_cli.derender.refine import REFINE_MODES
+from radar_cli.derender.run.inputs import DEFAULT_RESOLUTION, Resolution
+from radar_cli.derender.refine.driver import REFINE_MODES
 from radar_cli.errors import InputError
 
 
@@ -103,7 +103,7 @@ def derender(checkpoint: str | None, device: str, images: int, exports: int, bat
              workers: int, albedo: str, pitch: str, resolution: Resolution, refine: str) -> None:
     """Images per second for the network alone and for the full de-rendering with all exports; seconds per
     object and peak memory of the export at the output resolution."""
-    from radar_cli.derender.benchmark import bench_derender
+    from radar_cli.derender.run.benchmark import bench_derender
 
     click.echo(json.dumps(bench_derender(checkpoint, device, images, exports, batch_size, threads, workers=workers,
                                          albedo=albedo, pitch=pitch, resolution=resolution,  # type: ignore[arg-type]

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from radar_cli.derender.relight import relight as run_relight
+from radar_cli.derender.export.relight import relight as run_relight
 
 
 @click.command("relight")

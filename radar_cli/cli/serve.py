@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from radar_cli.derender.server import serve as run_server
+from radar_cli.derender.present.server import serve as run_server
 
 
 @click.command("serve")

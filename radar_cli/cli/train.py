@@ -65,7 +65,7 @@ def train(config_path: str, data_dir: str, run_dir: str, resume: bool, device: s
 def train_reader(config_path: str | None, data_dir: str, out_dir: str, base: str | None) -> None:
     """Teach the specular-albedo reader that `radar derender --refine` uses, from a model's f_L."""
     from radar_cli.config import load_toml
-    from radar_cli.derender.predictor import bundled_checkpoint
+    from radar_cli.derender.run.predictor import bundled_checkpoint
     from radar_cli.train.specular_reader import ReaderConfig, train_reader as run
 
     config = load_toml(ReaderConfig, config_path) if config_path else ReaderConfig()

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from radar_cli.evaluate.loading import read_env, read_json
-from radar_cli.fileio import read_image, write_image, write_json, write_npy
+from radar_cli.evaluate.loading import read_env
+from radar_cli.fileio import read_image, read_json, write_image, write_json, write_npy
 from radar_cli.results import ResultPaths
 from radar_cli.synth import layout
 

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import json
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -12,12 +10,9 @@ import numpy as np
 from radar_cli.dataset import IMAGE_FILE, MASK_FILE
 from radar_cli.errors import InputError
 from radar_cli.evaluate.metrics import decode_normals
-from radar_cli.fileio import read_image
+from radar_cli.fileio import number, read_image, read_json
 from radar_cli.results import ResultPaths
 from radar_cli.synth import layout
-
-MAX_JSON_BYTES = 1_000_000
-
 
 @dataclass(frozen=True)
 class Truth:
@@ -44,32 +39,6 @@ class Prediction:
     pitch: float
     alpha: float
     rho: float
-
-
-def read_json(path: Path) -> dict:
-    """A JSON object from a small file; InputError naming the file otherwise."""
-    try:
-        if path.stat().st_size > MAX_JSON_BYTES:
-            raise InputError(f"{path}: larger than {MAX_JSON_BYTES} bytes")
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise InputError(f"{path}: not valid JSON ({e})") from None
-    if not isinstance(data, dict):
-        raise InputError(f"{path}: expected a JSON object")
-    return data
-
-
-def number(data: dict, key: str, path: Path, index: int | None = None) -> float:
-    """data[key] (or data[key][index]) as a finite float; InputError naming the file and key otherwise."""
-    value = data.get(key)
-    if index is not None:
-        value = value[index] if isinstance(value, list) and len(value) > index else None
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        where = key if index is None else f"{key}[{index}]"
-        raise InputError(f"{path}: '{where}' must be a finite number, got {value!r}")
-    return float(value)
 
 
 def read_env(path: Path) -> np.ndarray:

@@ -54,7 +54,7 @@ class RadarModel(nn.Module):
     def read_appearance(self, image: torch.Tensor, radius: torch.Tensor, height: torch.Tensor,
                         pose: torch.Tensor) -> Decomposition:
         """f_L and f_A on the texture unwrapped from `image` with the given shape and pose (f_S's, or another
-        pose under test, derender.pitch_search).
+        pose under test, derender.refine.pitch_search).
 
         Args:
             image: B x 3 x H x W. radius: B x L; height: B; pose: B x 4.

@@ -12,7 +12,8 @@ import torch
 from radar_cli.fileio import write_text
 from radar_cli.model.config import RunConfig, load_run_config
 from radar_cli.model.losses import distance_transform
-from radar_cli.train import distributed as D
+from radar_cli import distributed as D
+from radar_cli.threads import torch_threads
 from radar_cli.train.step import Batch
 from radar_cli.train.trainer import build_state, train_step
 
@@ -50,7 +51,7 @@ def bench_train(config: RunConfig | str | Path, steps: int = 5, warmup: int = 2,
         config = load_run_config(config)
     dev = D.pick_device(device)
     n_threads = threads if threads is not None else (config.train.threads or torch.get_num_threads())
-    with D.torch_threads(n_threads):
+    with torch_threads(n_threads):
         sec, peak = _time_steps(config, batch_size or config.train.batch_size, dev, steps, warmup, profile)
     return {"preset": config.name, "device": str(dev), "batch_size": batch_size or config.train.batch_size,
             "image_size": config.model.render.image_size, "threads": n_threads, "sec_per_step": round(sec, 4),

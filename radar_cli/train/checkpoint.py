@@ -4,8 +4,8 @@ config, the step and the optimizers' settings as JSON metadata, so inference nee
     RUN_DIR/checkpoints/step_0001000.safetensors   written atomically; the last K are kept
     RUN_DIR/model.safetensors                      the model alone, exported when the run completes
 
-Exported weights (`export_weights`) are the same format with only the model's tensors. Loading never
-unpickles anything; a corrupt file or one that does not fit the configuration raises CheckpointError.
+Exported weights (`export_weights`) are the same format with only the model's tensors; radar_cli.model.weights
+reads both.
 """
 
 from __future__ import annotations
@@ -16,19 +16,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import torch
-from safetensors import SafetensorError
-from safetensors.torch import load_file, save_file
+from safetensors.torch import save_file
 from torch import nn
 
-from radar_cli.config import from_dict
-from radar_cli.errors import CheckpointError, ConfigError
+from radar_cli.errors import CheckpointError
 from radar_cli.fileio import atomic_path
-from radar_cli.model.config import ModelConfig, RunConfig, run_config_from_dict, to_dict
-from radar_cli.model.radar import RadarModel
+from radar_cli.model.config import RunConfig, to_dict
 from radar_cli.model.specular_reader import SpecularReader
+from radar_cli.model.weights import FORMAT, READER_FORMAT, load_module, module_tensors, read_checkpoint
 
-FORMAT = "radar-checkpoint-1"
-READER_FORMAT = "radar-specular-reader-1"  # a SpecularReader's weights, its ModelConfig and training record
 CHECKPOINT_DIR = "checkpoints"
 _NAME_RE = re.compile(r"^step_(\d{7,})\.safetensors$")
 MODEL_FILE = "model.safetensors"  # RUN_DIR/model.safetensors: weights + config only, written when a run completes
@@ -66,19 +62,6 @@ def restore_optimizer(opt: torch.optim.Optimizer, tensors: dict[str, torch.Tenso
     opt.load_state_dict({"state": state, "param_groups": json.loads(groups)})
 
 
-def module_tensors(module: nn.Module, prefix: str) -> dict[str, torch.Tensor]:
-    return {f"{prefix}.{k}": v.detach().cpu().contiguous() for k, v in module.state_dict().items()}
-
-
-def load_module(module: nn.Module, tensors: dict[str, torch.Tensor], prefix: str, path: Path) -> None:
-    sub = {k[len(prefix) + 1 :]: v for k, v in tensors.items() if k.startswith(prefix + ".")}
-    try:
-        module.load_state_dict(sub, strict=True)
-    except RuntimeError as e:
-        first = str(e).strip().splitlines()
-        raise CheckpointError(f"{path}: {prefix} weights do not fit the configuration ({' '.join(first)[:300]})") from None
-
-
 def save_checkpoint(run_dir: str | Path, config: RunConfig, state: TrainState, keep: int) -> Path:
     """Write RUN_DIR/checkpoints/step_<step>.safetensors atomically and delete all but the newest `keep`."""
     tensors = module_tensors(state.model, "model") | module_tensors(state.disc, "disc")
@@ -101,44 +84,6 @@ def list_checkpoints(run_dir: str | Path) -> list[Path]:
         return []
     found = [p for p in folder.iterdir() if _NAME_RE.match(p.name)]
     return sorted(found, key=lambda p: int(_NAME_RE.match(p.name).group(1)))  # type: ignore[union-attr]
-
-
-def read_checkpoint(path: str | Path) -> tuple[dict[str, torch.Tensor], dict[str, str], RunConfig]:
-    """Tensors, metadata and config of a checkpoint or exported weights file, validated.
-
-    Raises:
-        CheckpointError: missing, truncated or corrupt file, foreign format, or an invalid stored config.
-    """
-    tensors, meta = read_weights(path, FORMAT)
-    try:
-        config = run_config_from_dict(json.loads(meta["config"]))
-    except (KeyError, ValueError, ConfigError) as e:
-        raise CheckpointError(f"{path}: stored config is invalid ({e})") from None
-    return tensors, meta, config
-
-
-def read_weights(path: str | Path, expected_format: str,
-                 kind: str = "radar checkpoint") -> tuple[dict[str, torch.Tensor], dict[str, str]]:
-    """Tensors and metadata of a safetensors file whose metadata names `expected_format` (never unpickles);
-    `kind` names such a file in errors.
-
-    Raises:
-        CheckpointError: missing, truncated or corrupt file, or another format.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise CheckpointError(f"{path}: no such checkpoint")
-    try:
-        from safetensors import safe_open
-
-        with safe_open(str(path), framework="pt") as f:
-            meta = f.metadata() or {}
-        tensors = load_file(str(path))
-    except (SafetensorError, OSError, ValueError, RuntimeError) as e:
-        raise CheckpointError(f"{path}: corrupt or not a safetensors checkpoint ({e})") from None
-    if meta.get("format") != expected_format:
-        raise CheckpointError(f"{path}: not a {kind} (format {meta.get('format')!r}, expected {expected_format})")
-    return tensors, meta
 
 
 def restore(path: str | Path, config: RunConfig, state: TrainState) -> int:
@@ -190,18 +135,6 @@ def export_weights(checkpoint: str | Path, out: str | Path) -> Path:
     return Path(out)
 
 
-def load_model(path: str | Path, device: str | torch.device = "cpu") -> tuple[RadarModel, RunConfig]:
-    """A RadarModel in eval mode from a checkpoint or exported weights file, with the config it was trained with.
-
-    Raises:
-        CheckpointError: corrupt file or weights that do not fit the stored config.
-    """
-    tensors, _, config = read_checkpoint(path)
-    model = RadarModel(config.model)
-    load_module(model, tensors, "model", Path(path))
-    return model.to(device).eval(), config
-
-
 def save_specular_reader(reader: SpecularReader, path: str | Path, extra: dict[str, torch.Tensor] | None = None,
                          meta: dict[str, str] | None = None) -> Path:
     """Write a SpecularReader's weights (and `extra` tensors, e.g. its optimizer's) with its config, atomically."""
@@ -212,24 +145,3 @@ def save_specular_reader(reader: SpecularReader, path: str | Path, extra: dict[s
     return Path(path)
 
 
-def read_specular_reader(path: str | Path) -> tuple[SpecularReader, dict[str, torch.Tensor], dict[str, str]]:
-    """A SpecularReader (train mode, CPU) from its file, with the file's tensors and metadata.
-
-    Raises:
-        CheckpointError: missing or corrupt file, another format, or weights that do not fit the stored config.
-    """
-    tensors, meta = read_weights(path, READER_FORMAT, "radar specular-albedo reader")
-    try:
-        config = from_dict(ModelConfig, json.loads(meta["config"]), "reader config")
-        config.validate()
-    except (KeyError, ValueError, ConfigError) as e:
-        raise CheckpointError(f"{path}: stored config is invalid ({e})") from None
-    reader = SpecularReader(config)
-    load_module(reader, tensors, "reader", Path(path))
-    return reader, tensors, meta
-
-
-def load_specular_reader(path: str | Path, device: str | torch.device = "cpu") -> SpecularReader:
-    """A SpecularReader in eval mode from its file (CheckpointError as read_specular_reader)."""
-    reader, _, _ = read_specular_reader(path)
-    return reader.to(device).eval()

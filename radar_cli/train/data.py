@@ -20,7 +20,7 @@ from torch.utils.data import Sampler
 
 from radar_cli.dataset import SampleRef, list_samples, read_sample
 from radar_cli.errors import InputError
-from radar_cli.evaluate.loading import number, read_json
+from radar_cli.fileio import number, read_json
 from radar_cli.model.losses import distance_transform
 from radar_cli.model.outputs import Decomposition
 from radar_cli.results import MATERIAL_FILE

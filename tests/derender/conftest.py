@@ -11,7 +11,7 @@ import torch
 import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig
-from radar_cli.derender.predictor import ModelSetup, Predictor
+from radar_cli.derender.run.predictor import ModelSetup, Predictor
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.lighting import GAMMA
 

@@ -10,8 +10,8 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig
-from radar_cli.derender.bands import BandCue, band_coherence, high_pass
-from radar_cli.derender.fit_shape import ShapeFitConfig, axis_from_outline, closed_form, downsample, search_pitch
+from radar_cli.derender.refine.bands import BandCue, band_coherence, high_pass
+from radar_cli.derender.refine.fit_shape import ShapeFitConfig, axis_from_outline, closed_form, downsample, search_pitch
 from radar_cli.sor.outline import mask_outline
 from radar_cli.synth.generator import SynthConfig, make_sample
 

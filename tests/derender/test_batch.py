@@ -15,9 +15,9 @@ from click.testing import CliRunner
 from PIL import Image
 
 from radar_cli.cli import cli
-from radar_cli.derender.batch import DerenderOptions, derender
-from radar_cli.derender.export import ExportConfig
-from radar_cli.derender.predictor import Predictor
+from radar_cli.derender.run.batch import DerenderOptions, derender
+from radar_cli.derender.export.object_folder import ExportConfig
+from radar_cli.derender.run.predictor import Predictor
 from radar_cli.results import MATERIAL_KEYS, ResultPaths, list_results
 
 from .conftest import SETUP, SIZE, write_photo
@@ -161,7 +161,7 @@ def test_incomplete_folder_is_redone(tmp_path: Path, predictor: Predictor) -> No
 
 def test_parallel_exports_write_the_same_bytes_and_keep_going_past_a_failure(tmp_path: Path, predictor: Predictor,
                                                                               monkeypatch) -> None:
-    from radar_cli.derender import batch
+    from radar_cli.derender.run import batch
 
     for i, name in enumerate(["a", "b", "c", "d"]):
         write_photo(tmp_path / "in" / f"{name}.png", 10 + i)

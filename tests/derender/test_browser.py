@@ -21,12 +21,12 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from radar_cli.derender.batch import DerenderOptions, derender
-from radar_cli.derender.export import ExportConfig
-from radar_cli.derender.gallery import THUMBNAIL_FILE
-from radar_cli.derender.predictor import Predictor
-from radar_cli.derender.report import write_report
-from radar_cli.derender.server import make_server
+from radar_cli.derender.run.batch import DerenderOptions, derender
+from radar_cli.derender.export.object_folder import ExportConfig
+from radar_cli.derender.present.gallery import THUMBNAIL_FILE
+from radar_cli.derender.run.predictor import Predictor
+from radar_cli.derender.present.report import write_report
+from radar_cli.derender.present.server import make_server
 
 pytestmark = pytest.mark.browser
 REPO = Path(__file__).resolve().parents[2]

@@ -9,7 +9,7 @@ import pytest
 from click.testing import CliRunner
 
 from radar_cli.cli import cli
-from radar_cli.derender.predictor import ASSETS
+from radar_cli.derender.run.predictor import ASSETS
 from radar_cli.results import list_results
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"

@@ -9,7 +9,7 @@ import pytest
 import torch
 
 from radar_cli.config import CameraConfig
-from radar_cli.derender.fit_light import LightFitConfig, fit_environment, smoothness, upsampler
+from radar_cli.derender.refine.fit_light import LightFitConfig, fit_environment, smoothness, upsampler
 from radar_cli.evaluate.metrics import env_error
 from radar_cli.synth.generator import SynthConfig, make_sample
 

@@ -9,7 +9,7 @@ import pytest
 from PIL import Image
 
 from radar_cli.dataset import sample_ref, write_sample
-from radar_cli.derender.inputs import collect_inputs, prepare
+from radar_cli.derender.run.inputs import collect_inputs, prepare
 from radar_cli.errors import InputError
 
 from .conftest import SIZE, vase_photo, write_photo

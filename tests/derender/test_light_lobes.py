@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import torch
 
-from radar_cli.derender.light_lobes import LobeProblem, bake_lobes, direction, fit_lobes, peak_directions
+from radar_cli.derender.refine.light_lobes import LobeProblem, bake_lobes, direction, fit_lobes, peak_directions
 from radar_cli.evaluate.metrics import env_error
 from radar_cli.render.lighting import env_directions, phong_transport
 from radar_cli.synth.lighting import Lobe, bake_env

@@ -4,7 +4,7 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig, RenderConfig
-from radar_cli.derender.mesh import build_mesh
+from radar_cli.derender.export.mesh import build_mesh
 
 
 class _State:

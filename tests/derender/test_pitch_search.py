@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 import torch
 
-from radar_cli.derender.pitch_search import PitchSearch, _grid_scores, parabola_vertex, score, search_pitch
+from radar_cli.derender.refine.pitch_search import PitchSearch, _grid_scores, parabola_vertex, score, search_pitch
 from radar_cli.model.losses import distance_transform
-from radar_cli.derender.predictor import ASSETS, Predictor
+from radar_cli.derender.run.predictor import ASSETS, Predictor
 from radar_cli.errors import InputError
 
 from .test_predictor import save_weights, tiny_config

@@ -12,12 +12,12 @@ import torch
 from click.testing import CliRunner
 
 from radar_cli.cli import cli
-from radar_cli.derender.predictor import Predictor
+from radar_cli.derender.run.predictor import Predictor
+from radar_cli.model import weights
 from radar_cli.errors import CheckpointError, InputError
 
 from .conftest import write_photo
 
-checkpoint = pytest.importorskip("radar_cli.train.checkpoint")
 model_config = pytest.importorskip("radar_cli.model.config")
 
 
@@ -40,7 +40,7 @@ def save_weights(path: Path, config, weights_config=None) -> Path:
 
     model = RadarModel((weights_config or config).model)
     tensors = {f"model.{k}": v.contiguous() for k, v in model.state_dict().items()}
-    meta = {"format": checkpoint.FORMAT, "config": json.dumps(model_config.to_dict(config)), "step": "0"}
+    meta = {"format": weights.FORMAT, "config": json.dumps(model_config.to_dict(config)), "step": "0"}
     save_file(tensors, str(path), metadata=meta)
     return path
 

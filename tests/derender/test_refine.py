@@ -9,8 +9,8 @@ import pytest
 import torch
 
 from radar_cli.config import CameraConfig
-from radar_cli.derender import refine as refine_module
-from radar_cli.derender.refine import refine_object, silhouette_iou
+from radar_cli.derender.refine import driver as refine_module
+from radar_cli.derender.refine.driver import refine_object, silhouette_iou
 from radar_cli.model.outputs import Decomposition
 from radar_cli.synth.generator import SynthConfig, make_sample
 

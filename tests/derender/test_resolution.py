@@ -16,11 +16,11 @@ from PIL import Image
 from scipy.ndimage import binary_erosion
 
 from radar_cli.cli import cli
-from radar_cli.derender.batch import DerenderOptions, derender
-from radar_cli.derender.export import ExportConfig
-from radar_cli.derender.inputs import InputItem, output_side, prepare
-from radar_cli.derender.predictor import ASSETS, Predictor
-from radar_cli.derender.upsample import PROFILE_ROWS, full_resolution_state
+from radar_cli.derender.run.batch import DerenderOptions, derender
+from radar_cli.derender.export.object_folder import ExportConfig
+from radar_cli.derender.run.inputs import InputItem, output_side, prepare
+from radar_cli.derender.run.predictor import ASSETS, Predictor
+from radar_cli.derender.run.upsample import PROFILE_ROWS, full_resolution_state
 from radar_cli.errors import InputError
 
 from .conftest import SETUP, SIZE, FakeModel, vase_photo, write_photo
@@ -119,7 +119,7 @@ def _striped_photo(path: Path) -> Path:
 def test_divided_albedo_at_the_output_side_draws_the_crop_back(tmp_path: Path) -> None:
     """The divided albedo re-shaded and drawn at N gives the N px crop back where the surface lies on the object
     (median 2 grey levels measured); f_A's albedo upsampled cannot (14)."""
-    from radar_cli.derender.renders import ViewRenderer
+    from radar_cli.derender.export.renders import ViewRenderer
 
     predictor = Predictor(FakeModel(), SETUP, "fake-model", "cpu")
     prepared = prepare(InputItem("v", _striped_photo(tmp_path / "v.png")), SIZE, resolution=SIDE)
@@ -158,8 +158,8 @@ def test_cli_photo_resolution_with_the_bundled_model(tmp_path: Path) -> None:
 
 
 def test_large_exports_encode_fast_and_keep_their_pixels(tmp_path: Path) -> None:
-    from radar_cli.derender.maps import FAST_ENCODE_PIXELS, write_picture
-    from radar_cli.derender.renders import gif_frames
+    from radar_cli.derender.export.maps import FAST_ENCODE_PIXELS, write_picture
+    from radar_cli.derender.export.renders import gif_frames
 
     rng = np.random.default_rng(0)
     image = rng.integers(0, 256, (512, 512, 3), dtype=np.uint8)

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from radar_cli.derender.batch import DerenderOptions, derender
-from radar_cli.derender.export import ExportConfig
-from radar_cli.derender.predictor import Predictor
+from radar_cli.derender.run.batch import DerenderOptions, derender
+from radar_cli.derender.export.object_folder import ExportConfig
+from radar_cli.derender.run.predictor import Predictor
 
 from .conftest import SETUP, FakeModel, write_photo
 

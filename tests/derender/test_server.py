@@ -12,7 +12,7 @@ import pytest
 from click.testing import CliRunner
 
 from radar_cli.cli import cli
-from radar_cli.derender.server import make_server
+from radar_cli.derender.present.server import make_server
 from radar_cli.errors import InputError
 
 

@@ -16,10 +16,10 @@ import pytest
 from click.testing import CliRunner
 
 from radar_cli.cli import cli
-from radar_cli.derender.batch import DerenderOptions, derender
-from radar_cli.derender.export import ExportConfig
-from radar_cli.derender.predictor import Predictor
-from radar_cli.derender.shard import Shard
+from radar_cli.derender.run.batch import DerenderOptions, derender
+from radar_cli.derender.export.object_folder import ExportConfig
+from radar_cli.derender.run.predictor import Predictor
+from radar_cli.derender.run.shard import Shard
 from radar_cli.errors import InputError
 
 from .conftest import SETUP, FakeModel, write_photo

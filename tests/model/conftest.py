@@ -8,7 +8,7 @@ import torch
 from radar_cli.config import GeometryConfig, RenderConfig
 from radar_cli.model.config import LossConfig, ModelConfig, RunConfig, TrainConfig
 from radar_cli.model.losses import distance_transform
-from radar_cli.train.distributed import torch_threads
+from radar_cli.threads import torch_threads
 from radar_cli.train.step import Batch
 
 

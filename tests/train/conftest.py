@@ -12,7 +12,7 @@ import torch
 
 from radar_cli.config import GeometryConfig, RenderConfig
 from radar_cli.dataset import sample_ref, write_sample
-from radar_cli.train.distributed import torch_threads
+from radar_cli.threads import torch_threads
 from radar_cli.model.config import LossConfig, ModelConfig, RunConfig, TrainConfig
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_view

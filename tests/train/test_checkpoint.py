@@ -9,8 +9,8 @@ import torch
 from safetensors.torch import save_file
 
 from radar_cli.errors import CheckpointError
-from radar_cli.train.checkpoint import (export_weights, initialise, list_checkpoints, load_model, read_checkpoint,
-                                        restore, save_checkpoint)
+from radar_cli.model.weights import load_model, read_checkpoint
+from radar_cli.train.checkpoint import export_weights, initialise, list_checkpoints, restore, save_checkpoint
 from radar_cli.train.trainer import build_state
 
 from .conftest import tiny_config

@@ -1,5 +1,5 @@
 """A few spherical-Gaussian lobes fitted to the unwrapped texture's shading (the lighting fit's light model,
-derender.fit_light; docs/refinement.md).
+derender.refine.fit_light; docs/refinement.md).
 
 A lobe is the supplementary's light, L(eta) = sqrt(lambda) F exp(-lambda (1 - eta . xi)) (the model radar synth
 draws its lighting from, synth.lighting), with its direction xi at elevation el and azimuth az in the convention

@@ -12,16 +12,16 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from radar_cli.derender.batch import EXPORT_THREADS, DerenderOptions, derender, environments
-from radar_cli.derender.export import ExportConfig, export_object
-from radar_cli.derender.inputs import DEFAULT_RESOLUTION, InputItem, Resolution, output_side, prepare
-from radar_cli.derender.predictor import AlbedoSource, PitchSource, Predictor
-from radar_cli.derender.refine import RefineMode
-from radar_cli.derender.upsample import full_resolution_state
+from radar_cli.derender.run.batch import EXPORT_THREADS, DerenderOptions, derender, environments
+from radar_cli.derender.export.object_folder import ExportConfig, export_object
+from radar_cli.derender.run.inputs import DEFAULT_RESOLUTION, InputItem, Resolution, output_side, prepare
+from radar_cli.derender.run.predictor import AlbedoSource, PitchSource, Predictor
+from radar_cli.derender.refine.driver import RefineMode
+from radar_cli.derender.run.upsample import full_resolution_state
 from radar_cli.fileio import write_image
 from radar_cli.threads import torch_threads
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
 PHOTO_MARGIN = 1.6  # photos this much larger than the output side: the examples' crop windows span 0.68-1.05 of them
 
 

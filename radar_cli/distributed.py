@@ -1,13 +1,12 @@
-"""Multi-process training under `torchrun`: process-group set-up (NCCL on GPUs, gloo on CPU), DDP wrapping and
-the few collectives the loop needs. Without torchrun's environment everything degrades to a single process.
+"""Multi-process runs under `torchrun` (training, sharded de-rendering): process-group set-up (NCCL on GPUs, gloo on
+CPU), DDP wrapping and the few collectives the loops need. Without torchrun's environment everything degrades to a
+single process.
 """
 
 from __future__ import annotations
 
 import os
-from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Iterator
 
 import torch
 import torch.distributed as dist
@@ -107,18 +106,3 @@ def barrier(info: DistInfo) -> None:
     """Wait for all ranks (no-op single-process)."""
     if info.enabled:
         dist.barrier()
-
-
-@contextmanager
-def torch_threads(n: int) -> Iterator[None]:
-    """Run a block with n torch CPU threads (n <= 0: unchanged), restoring the previous count after it.
-
-    On a shared machine fewer threads than cores is often faster: OpenMP threads spin while they wait.
-    """
-    before = torch.get_num_threads()
-    if n > 0:
-        torch.set_num_threads(n)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(before)

@@ -8,7 +8,7 @@ its paint's centre (a thin line, an anti-aliased edge) is left out. The image is
 and each paint's linear albedo follows from the lighting in closed form (least squares over its texels), with
 shininess and specular albedo held at the network's.
 
-The light is a few soft lights: spherical-Gaussian lobes (derender.light_lobes). A regularised least-squares
+The light is a few soft lights: spherical-Gaussian lobes (derender.refine.light_lobes). A regularised least-squares
 solve for a coarse free map, alternating with the paints, finds where the light comes from; lobes started at
 its brightest peaks are fitted by Levenberg-Marquardt, again alternating with the paints, once for each of a few
 lobe counts. The photograph pins the light only loosely, and the fits disagree where it does not: the map is
@@ -16,7 +16,7 @@ the mean of their maps. It keeps the starting map's mean, since the albedo's bri
 be told apart.
 
 Only the environment map is fitted here; shininess and specular albedo are held at what the caller read
-(derender.refine: f_L's shininess, the specular-albedo reader's specular albedo). With the map unknown, a sharper
+(derender.refine.driver: f_L's shininess, the specular-albedo reader's specular albedo). With the map unknown, a sharper
 light and a lower shininess, or a brighter light in the highlight's direction and a lower specular albedo, draw
 the same photograph (docs/refinement.md measures it).
 """
@@ -32,7 +32,7 @@ import torch
 import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig
-from radar_cli.derender.light_lobes import LobeProblem, fit_lobes
+from radar_cli.derender.refine.light_lobes import LobeProblem, fit_lobes
 from radar_cli.render.lighting import GAMMA, decompose, env_directions, phong_transport, tone_map
 from radar_cli.render.texture import sample_surface
 from radar_cli.sor.surface import surface_grid

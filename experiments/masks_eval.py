@@ -1,6 +1,6 @@
 """Accuracy of the masks pipeline on generated material with known answers.
 
-    python -m radar_cli.masks.evaluate --per-kind 50     # the table in the report (renders 50 vases, ~1 min)
+    python -m experiments.masks_eval --per-kind 50     # the table in the report (renders 50 vases, ~1 min)
 
 - composites: rendered vases over each backdrop kind; IoU between the crop's mask and the ground truth
   warped by the same crop;
@@ -19,7 +19,13 @@ from radar_cli.masks import crop as crops
 from radar_cli.masks.pipeline import Settings, process_image
 from radar_cli.masks.quality import Thresholds, sor_score
 from radar_cli.masks.refine import iou
-from radar_cli.masks.synthetic import BACKDROPS, NON_SOR, composite, non_sor_mask, render_vases
+from radar_cli.masks.synthetic import (
+    BACKDROPS,
+    NON_SOR,
+    composite,
+    non_sor_mask,
+    render_vases,
+)
 
 
 def composite_iou(photo: np.ndarray, truth: np.ndarray, settings: Settings) -> float:

@@ -9,9 +9,9 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-from radar_cli.derender.inputs import Prepared
-from radar_cli.derender.predictor import AlbedoSource, ModelSetup
-from radar_cli.derender.state import ObjectState
+from radar_cli.derender.run.inputs import Prepared
+from radar_cli.derender.run.predictor import AlbedoSource, ModelSetup
+from radar_cli.derender.run.state import ObjectState
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.scene import divide_shading, shade
 from radar_cli.sor.resample import smooth_rows

@@ -1,5 +1,5 @@
 """The results root's overview files: summary.csv (one row per object), failures.csv (one row per input that
-could not be de-rendered) and the gallery (index.html, see radar_cli.derender.gallery)."""
+could not be de-rendered) and the gallery (index.html, see radar_cli.derender.present.gallery)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import io
 import json
 from pathlib import Path
 
-from radar_cli.derender.gallery import write_gallery
-from radar_cli.derender.inputs import Failure
+from radar_cli.derender.present.gallery import write_gallery
+from radar_cli.derender.run.inputs import Failure
 from radar_cli.fileio import write_text
 from radar_cli.results import FAILURES_FILE, MATERIAL_FILE, SUMMARY_FILE, list_results
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from radar_cli.derender.state import ObjectState
+from radar_cli.derender.run.state import ObjectState
 from radar_cli.fileio import atomic_path, encode_png_fast, to_uint8, write_bytes, write_image, write_npy
 from radar_cli.render.lighting import tone_map
 from radar_cli.render.scene import shade

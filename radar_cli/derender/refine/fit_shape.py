@@ -7,7 +7,7 @@ in closed form (the axis from the rows' midpoints, the profile from the rows' wi
 from the outline's top and bottom); each candidate is scored by how well it draws the outline plus how much its
 profile has to bend. Where the open mouth is visible, the rim's front arc is an edge in the image (the inside is
 darker than the outer wall below the lip) and its contrast picks the pitch; where the pot is painted in
-horizontal bands, their edges run straight across the texture unwrapped at the right pitch (derender.bands), which
+horizontal bands, their edges run straight across the texture unwrapped at the right pitch (derender.refine.bands), which
 picks the pitch or bounds the lip's search. A fine grid then narrows it, and the profile, height, roll and offset
 are polished by Adam at full resolution with the pitch held.
 """
@@ -22,7 +22,7 @@ import torch
 import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig
-from radar_cli.derender.bands import BandCue, band_coherence, high_pass
+from radar_cli.derender.refine.bands import BandCue, band_coherence, high_pass
 from radar_cli.sor.outline import Outline, disc_conics, mask_outline, outline, roots, vertical_extent
 from radar_cli.sor.pose import rotation_matrix, translation
 
@@ -43,7 +43,7 @@ class ShapeFitConfig:
         band_ratio: painted bands pick the pitch where their coherence peaks at least this many times its lowest
             over the grid.
         band_reach: where they do, the lip is looked for within this of their peak (degrees).
-        bands: how the bands are read (derender.bands).
+        bands: how the bands are read (derender.refine.bands).
         prior_reach: without bands or a lip, the outline's pick stays at most this above the network's pitch (degrees);
             below it the outline is free (the network reads low pitches too high; a thick rim or a bevelled foot
             makes the outline read too high).

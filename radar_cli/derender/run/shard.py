@@ -1,5 +1,5 @@
-"""Splitting one `radar derender` collection over processes and machines: which inputs a share owns, the
-per-share failure lists, and the torchrun driver in which rank 0 writes the one report for all.
+"""Splitting one `radar derender` collection over processes and machines: which inputs a share owns and the
+per-share failure lists (run/launch.py drives the shares).
 
 A share owns whole batches of the single-process run (batch k goes to share k mod N), so every object is
 predicted beside the same neighbours as without sharding and its files are the same bytes. Shares meet only
@@ -9,20 +9,15 @@ through the results folder (a filesystem all machines see), so `--shard K/N` nee
 from __future__ import annotations
 
 import csv
-import dataclasses
 import io
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable, Sequence, TypeVar
+from typing import Sequence, TypeVar
 
-from radar_cli.derender.inputs import Failure
+from radar_cli.derender.run.inputs import Failure
 from radar_cli.errors import InputError
 from radar_cli.fileio import write_text
-
-if TYPE_CHECKING:
-    from radar_cli.derender.batch import BatchSummary, DerenderOptions
-    from radar_cli.derender.predictor import Predictor
 
 T = TypeVar("T")
 SHARDS_DIR = ".shards"  # RESULTS/.shards/failures-K-of-N.csv: each share's failures, merged into failures.csv
@@ -84,41 +79,3 @@ def read_share_failures(out: Path, count: int) -> list[Failure]:
             if len(row) == 2:
                 merged.setdefault((row[0], row[1]), Failure(row[0], row[1]))
     return list(merged.values())
-
-
-def derender_sharded(inputs: list[str | Path], load: Callable[[str], "Predictor"], options: "DerenderOptions",
-                     device: str, say: Callable[[str], None]) -> "BatchSummary":
-    """Run `radar derender` as one share of a collection.
-
-    Under torchrun (WORLD_SIZE > 1) the rank is the share; ranks wait for each other at the end and rank 0 writes
-    summary.csv, failures.csv and the gallery for all. Otherwise options.shard says the share (1/1: the whole
-    collection) and the share writes the report from every complete folder and every share's failures found.
-
-    Args:
-        inputs: image files and folders, the same on every share.
-        load: device name -> Predictor (each rank loads the model on its own device).
-        options: the run's options; options.shard must be 0/1 under torchrun.
-        device: --device (under torchrun with CUDA each rank takes its LOCAL_RANK's GPU).
-        say: where one-line messages go.
-
-    Returns:
-        This share's BatchSummary (its `index` set on the share that wrote the report).
-    """
-    from radar_cli.derender.batch import derender
-    from radar_cli.derender.report import write_report
-    from radar_cli.train import distributed
-
-    info = distributed.setup(device)
-    try:
-        if info.enabled and options.shard.enabled:
-            raise InputError("--shard cannot be combined with torchrun (each rank takes its share already)")
-        shard = Shard(info.rank, info.world) if info.enabled else options.shard
-        options = dataclasses.replace(options, shard=shard)
-        summary = derender(inputs, load(str(info.device)), options, say, report=not info.enabled)
-        distributed.barrier(info)  # every share's folders and failure list are written
-        if info.enabled and info.is_main:
-            summary.index = write_report(options.out, read_share_failures(options.out, shard.count))
-        distributed.barrier(info)  # no rank exits (and has torchrun stop the others) before the report is done
-        return summary
-    finally:
-        distributed.teardown(info)

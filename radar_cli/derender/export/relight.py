@@ -7,9 +7,9 @@ from pathlib import Path
 
 import torch
 
-from radar_cli.derender.environments import load_environment, match_exposure
-from radar_cli.derender.renders import render_object
-from radar_cli.derender.state import read_record, read_state
+from radar_cli.derender.export.environments import load_environment, match_exposure
+from radar_cli.derender.export.renders import render_object
+from radar_cli.derender.run.state import read_record, read_state
 from radar_cli.errors import InputError
 from radar_cli.fileio import write_image
 
@@ -22,7 +22,7 @@ def relight(folder: str | Path, env_path: str | Path, out: str | Path, yaw_deg: 
 
     Args:
         folder: RESULTS/<object> written by `radar derender`.
-        env_path: .hdr, .exr, .png/.jpg or .npy environment map (camera frame, see radar_cli.derender.environments).
+        env_path: .hdr, .exr, .png/.jpg or .npy environment map (camera frame, see radar_cli.derender.export.environments).
         out: the image to write (.png, .jpg, .webp).
         yaw_deg: spin about the object's axis.
         pitch_deg: camera elevation in degrees (default: the predicted pitch).

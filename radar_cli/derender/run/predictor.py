@@ -13,16 +13,17 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig
-from radar_cli.derender.fit_light import LightFitConfig
-from radar_cli.derender.pitch_search import search_pitch
-from radar_cli.derender.refine import REFINE_MODES, RefineMode, RefineReport, refine_object
+from radar_cli.derender.refine.fit_light import LightFitConfig
+from radar_cli.derender.refine.pitch_search import search_pitch
+from radar_cli.derender.refine.driver import REFINE_MODES, RefineMode, RefineReport, refine_object
 from radar_cli.errors import CheckpointError, InputError
 from radar_cli.model.outputs import Decomposition
 from radar_cli.model.radar import RadarModel
 from radar_cli.model.specular_reader import SpecularReader
+from radar_cli.model.weights import load_model, load_specular_reader
 from radar_cli.render.scene import divide_shading, shade
 
-ASSETS = Path(__file__).resolve().parents[1] / "assets"
+ASSETS = Path(__file__).resolve().parents[2] / "assets"
 READER_ASSET = "readers/specular_albedo.safetensors"  # the bundled reader (pipelines/readers/specular_albedo.toml)
 BUNDLED, NO_READER = "bundled", "none"  # --specular-reader's named values
 AlbedoSource = Literal["network", "divided"]
@@ -50,8 +51,6 @@ def load_reader(reader: str | Path, camera: CameraConfig, device: torch.device) 
     if str(reader) == NO_READER:
         return None
     path = reader_path(reader)
-    from radar_cli.train.checkpoint import load_specular_reader
-
     loaded = load_specular_reader(path, device)
     if loaded.config.camera != camera:
         raise CheckpointError(f"{path}: the reader was trained with another camera than the model's")
@@ -95,10 +94,10 @@ class Predictor:
         albedo: `divided`: the input's texture divided by the predicted shading (render.scene.divide_shading;
             about 0.6x the albedo error of f_A's on synthetic vases, docs/accuracy.md); `network`: f_A's
             albedo, as the paper.
-        pitch: `network`: f_S's pitch; `search`: derender.pitch_search where the silhouette is known (needs a
+        pitch: `network`: f_S's pitch; `search`: derender.refine.pitch_search where the silhouette is known (needs a
             RadarModel), f_S's elsewhere.
         refine: `full`: each object's shape and pose fitted at the output resolution, f_L and f_A re-read
-            there, and the environment map fitted to the crop's shading (derender.refine; needs a RadarModel);
+            there, and the environment map fitted to the crop's shading (derender.refine.driver; needs a RadarModel);
             `shape`: the same without the lighting fit; `none`: the network's prediction as it is.
         reader: reads the specular albedo at the refined shape (model.specular_reader; None: f_L's re-reading).
     """
@@ -134,10 +133,6 @@ class Predictor:
         if not path.is_file():
             raise CheckpointError(f"{path}: no such checkpoint")
         dev = resolve_device(device)
-        try:
-            from radar_cli.train.checkpoint import load_model
-        except ImportError as e:
-            raise CheckpointError(f"{path}: this build cannot load checkpoints ({e})") from None
         model, _ = load_model(path, dev)
         model.eval()
         cfg = model.config
@@ -183,7 +178,7 @@ class Predictor:
 
     def refine_object(self, dec: Decomposition, image: np.ndarray, crop: np.ndarray,
                       silhouette: np.ndarray | None) -> tuple[Decomposition, RefineReport]:
-        """One object's prediction refined at the output resolution (derender.refine), or kept.
+        """One object's prediction refined at the output resolution (derender.refine.driver), or kept.
 
         Args:
             dec: its Decomposition (batch of one, CPU). image: the S x S x 3 uint8 network input.

@@ -13,9 +13,9 @@ import torch.nn.functional as F
 from PIL import Image
 
 from radar_cli.config import CameraConfig
-from radar_cli.derender.environments import match_exposure
-from radar_cli.derender.maps import FAST_ENCODE_PIXELS, chw_image, write_picture
-from radar_cli.derender.state import ObjectState
+from radar_cli.derender.export.environments import match_exposure
+from radar_cli.derender.export.maps import FAST_ENCODE_PIXELS, chw_image, write_picture
+from radar_cli.derender.run.state import ObjectState
 from radar_cli.fileio import atomic_path, to_uint8
 from radar_cli.render.lighting import compose, tone_map
 from radar_cli.render.raycast import Hits, cast_rays

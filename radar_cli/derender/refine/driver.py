@@ -1,8 +1,8 @@
 """Per-object refinement after the network (`radar derender --refine full`, the default): the shape and pose
-fitted to the silhouette and the rim at the crop's resolution (derender.fit_shape), the lighting, material and
+fitted to the silhouette and the rim at the crop's resolution (derender.refine.fit_shape), the lighting, material and
 albedo networks re-read at the fitted shape, the specular albedo read there by the specular-albedo reader
 (model.specular_reader; or f_L's, held at most 1), then the environment map fitted to the photograph's shading there
-(derender.fit_light). A shape fit that fails, or draws the outline worse than the network's prediction, falls back
+(derender.refine.fit_light). A shape fit that fails, or draws the outline worse than the network's prediction, falls back
 to the network's and says why (material.json `refine`, summary.csv); a lighting fit with too few usable texels
 keeps the network's map. `--refine shape` stops after the re-reading."""
 
@@ -17,8 +17,8 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig
-from radar_cli.derender.fit_light import LightFitConfig, fit_environment
-from radar_cli.derender.fit_shape import ShapeFitConfig, fit_shape, outline_score
+from radar_cli.derender.refine.fit_light import LightFitConfig, fit_environment
+from radar_cli.derender.refine.fit_shape import ShapeFitConfig, fit_shape, outline_score
 from radar_cli.masks.refine import iou
 from radar_cli.model.outputs import Decomposition
 from radar_cli.model.specular_reader import SpecularReader
@@ -144,7 +144,7 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
 def _fit_light(refined: Decomposition, network_env: torch.Tensor, crop: np.ndarray, silhouette: np.ndarray,
                camera: CameraConfig, config: LightFitConfig, report: RefineReport) -> tuple[Decomposition,
                                                                                              RefineReport]:
-    """`refined` with its environment map fitted to the crop's shading (derender.fit_light), starting from the
+    """`refined` with its environment map fitted to the crop's shading (derender.refine.fit_light), starting from the
     network's first reading `network_env` (1 x He x We), or with that map where too few texels are usable."""
     with torch.no_grad():
         fit = fit_environment(crop, silhouette, refined.radius, refined.height, refined.pose, network_env,

@@ -10,8 +10,8 @@ import numpy as np
 import trimesh
 from PIL import Image
 
-from radar_cli.derender.maps import chw_image
-from radar_cli.derender.state import ObjectState, roughness_from_shininess
+from radar_cli.derender.export.maps import chw_image
+from radar_cli.derender.run.state import ObjectState, roughness_from_shininess
 from radar_cli.fileio import write_bytes
 from radar_cli.render.lighting import tone_map
 from radar_cli.results import MESH_GLB_FILE, MESH_OBJ_FILE

@@ -9,7 +9,7 @@ absolute error by Monte Carlo, against the best constant guess (the prior median
 which would also depend on lambda, is left out: it is the light blurred by a cosine lobe (about 60 deg wide),
 which hides the difference between 10 deg and 18 deg wide lights under any painted texture.
 
-    .venv/bin/python docs/shininess_limit.py
+    .venv/bin/python -m experiments.shininess_limit
 """
 
 from __future__ import annotations

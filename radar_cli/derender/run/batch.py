@@ -3,7 +3,7 @@
 One bad input costs one line and one failures.csv row; the rest are processed. Finished object folders are
 skipped (a killed run resumes) and never overwritten without `overwrite`. Batches are cut from the whole input
 list before finished objects are dropped, so an object is always predicted beside the same neighbours (its files
-are the same bytes whether the run was resumed or split into shares, see radar_cli.derender.shard).
+are the same bytes whether the run was resumed or split into shares, see radar_cli.derender.run.shard).
 """
 
 from __future__ import annotations
@@ -18,14 +18,14 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from radar_cli.derender.environments import builtin_environments, env_name, load_environment
-from radar_cli.derender.export import ExportConfig, export_object, is_complete
-from radar_cli.derender.inputs import (DEFAULT_RESOLUTION, Backdrop, CropMode, Failure, InputItem, Prepared,
+from radar_cli.derender.export.environments import builtin_environments, env_name, load_environment
+from radar_cli.derender.export.object_folder import ExportConfig, export_object, is_complete
+from radar_cli.derender.run.inputs import (DEFAULT_RESOLUTION, Backdrop, CropMode, Failure, InputItem, Prepared,
                                        Resolution, collect_inputs, output_side, prepare)
-from radar_cli.derender.predictor import Predictor
-from radar_cli.derender.report import write_report
-from radar_cli.derender.shard import Shard, read_share_failures, write_share_failures
-from radar_cli.derender.upsample import full_resolution_state
+from radar_cli.derender.run.predictor import Predictor
+from radar_cli.derender.present.report import write_report
+from radar_cli.derender.run.shard import Shard, read_share_failures, write_share_failures
+from radar_cli.derender.run.upsample import full_resolution_state
 from radar_cli.errors import InputError, RadarError
 from radar_cli.fileio import remove_stale_temps
 from radar_cli.model.outputs import Decomposition

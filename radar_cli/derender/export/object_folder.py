@@ -8,13 +8,13 @@ from pathlib import Path
 
 import numpy as np
 
-from radar_cli.derender.inputs import InputItem, Prepared
-from radar_cli.derender.maps import write_maps, write_picture
-from radar_cli.derender.mesh import write_meshes
-from radar_cli.derender.predictor import AlbedoSource, ModelSetup, PitchSource
-from radar_cli.derender.quality import assess_drawn
-from radar_cli.derender.renders import write_renders
-from radar_cli.derender.state import ObjectState
+from radar_cli.derender.run.inputs import InputItem, Prepared
+from radar_cli.derender.export.maps import write_maps, write_picture
+from radar_cli.derender.export.mesh import write_meshes
+from radar_cli.derender.run.predictor import AlbedoSource, ModelSetup, PitchSource
+from radar_cli.derender.export.quality import assess_drawn
+from radar_cli.derender.export.renders import write_renders
+from radar_cli.derender.run.state import ObjectState
 from radar_cli.fileio import write_json
 from radar_cli.results import APPENDAGES_FILE, INPUT_FILE, MATERIAL_FILE, SILHOUETTE_FILE
 
@@ -58,7 +58,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         config: turntable and view settings.
         albedo_source: where the albedo came from (`network` or `divided`, see Predictor).
         pitch_source: where the pitch came from (`network` or `search`, see Predictor).
-        refine: what the per-object refinement did (derender.refine.RefineReport.record()), if it ran.
+        refine: what the per-object refinement did (derender.refine.driver.RefineReport.record()), if it ran.
 
     Returns:
         The material.json record.

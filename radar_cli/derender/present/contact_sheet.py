@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw
 
-from radar_cli.derender.renders import relit_file
-from radar_cli.derender.report import read_records
+from radar_cli.derender.export.renders import relit_file
+from radar_cli.derender.present.report import read_records
 from radar_cli.errors import InputError
 from radar_cli.fileio import write_image
 from radar_cli.results import ALBEDO_RENDERED_FILE, INPUT_FILE, MASK_FILE, RECON_FILE

@@ -1,6 +1,6 @@
 """How well objects are located in hard framings, and whether the quality status tells good results from bad.
 
-    python -m radar_cli.masks.framing_eval --synthetic 24      # the table in docs/real-photos.md
+    python -m experiments.framing_eval --synthetic 24      # the table in docs/real-photos.md
 
 Sources: the real photographs of ../shared/data/real_vases (when present; the reference silhouette is the one
 located on the original photo) and rendered vases pasted over studio backdrops (the truth is known). Each is
@@ -20,13 +20,24 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from radar_cli.derender.export.quality import assess
+from radar_cli.derender.run.inputs import (
+    Prepared,
+    located_input,
+    white_backdrop,
+    whole_photo,
+)
+from radar_cli.derender.run.predictor import Predictor
+from radar_cli.derender.run.state import ObjectState
+from radar_cli.errors import InputError
+from radar_cli.fileio import read_image, write_image
 from radar_cli.masks import crop as crops
 from radar_cli.masks.locate import locate_object
 from radar_cli.masks.refine import iou
 from radar_cli.masks.synthetic import composite, render_vases
 from radar_cli.masks.variants import KINDS, Variant, make_variant, with_handles
 
-REAL_DIR = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "real_vases"
+REAL_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real_vases"  # ../shared from the repo
 EVAL_SIZE = 256  # silhouettes are compared in crops of this side
 SOURCE_SIDE = 600  # real photos are brought to this long side first (speed; the framings are what is tested)
 
@@ -50,7 +61,6 @@ def photo_mask(mask: np.ndarray, box: crops.CropBox, shape: tuple[int, int]) -> 
 
 def real_sources(folder: Path) -> list[tuple[str, np.ndarray, np.ndarray]]:
     """(name, photo at SOURCE_SIDE, silhouette located on it) of every photo in `folder`."""
-    from radar_cli.fileio import read_image
 
     out = []
     for path in sorted(folder.glob("*.jpg")):
@@ -76,7 +86,6 @@ def synthetic_sources(n: int, seed: int) -> list[tuple[str, np.ndarray, np.ndarr
 def located_iou(variant: Variant) -> tuple[float, float]:
     """(IoU of the located object with the variant's truth, IoU of the located core with it), both in the
     located crop; (0, 0) if nothing is found."""
-    from radar_cli.errors import InputError
 
     try:
         found = locate_object(variant.image, EVAL_SIZE)
@@ -116,13 +125,11 @@ def spoilt_input(kind: str, variant: Variant, size: int):
     its width). Returns (Prepared, IoU of its silhouette with the truth)."""
     import dataclasses
 
-    from radar_cli.derender.inputs import located_input, white_backdrop, whole_photo
 
     if kind == "whole_frame":
         rgb = variant.image[..., :3]
         box = whole_photo(rgb)
         frame = crops.cut(np.ones(rgb.shape[:2], np.float32), box, size, fill=0) > 0.5
-        from radar_cli.derender.inputs import Prepared
 
         prepared = Prepared(crops.cut(rgb, box, size), box, rgb.shape[1::-1], silhouette=frame,
                             cut_edges=("top", "bottom", "left", "right"), frame_coverage=1.0)
@@ -155,11 +162,6 @@ def add_spoilt(results: Results, items: list[tuple[str, Variant]], size: int) ->
 def judge_status(results: Results, items: list[tuple[str, Variant]], batch: int = 16) -> None:
     """De-render every item as `radar derender` does (bundled model) and record its quality status; spoilt
     silhouettes (`BROKEN`) are added and judged as well."""
-    from radar_cli.derender.inputs import located_input
-    from radar_cli.derender.predictor import Predictor
-    from radar_cli.derender.quality import assess
-    from radar_cli.derender.state import ObjectState
-    from radar_cli.errors import InputError
 
     predictor = Predictor.from_checkpoint(device="cpu")
     size = predictor.setup.image_size
@@ -227,7 +229,6 @@ def overlay(found_image: np.ndarray, core: np.ndarray, appendages: np.ndarray) -
 def worst_sheet(results: Results, items: list[tuple[str, Variant]], path: Path, n: int = 8,
                 side: int = 160) -> None:
     """A PNG of the n worst-located variants: the photo, then the located core (red) and appendages (blue)."""
-    from radar_cli.fileio import write_image
 
     tiles = []
     for i in sorted(range(len(items)), key=lambda i: results.rows[i]["iou"])[:n]:

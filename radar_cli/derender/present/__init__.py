@@ -1,0 +1,1 @@
+"""Presenting a results folder: summary and failures tables, the HTML gallery, its server, contact sheets."""

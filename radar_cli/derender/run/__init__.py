@@ -1,0 +1,1 @@
+"""Running the network over a collection: reading and cropping inputs, predicting, batches, shares, timing."""
