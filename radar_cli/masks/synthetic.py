@@ -10,6 +10,7 @@ import math
 import cv2
 import numpy as np
 import torch
+from radar_cli.sor.solid import Solid
 
 BACKDROPS = ("plain", "gradient", "textured", "shadow", "label")
 
@@ -44,7 +45,7 @@ def render_vases(n: int, size: int, seed: int) -> tuple[np.ndarray, np.ndarray, 
     pose = torch.tensor(np.stack([rng.uniform(0, 20, n), rng.uniform(-5, 5, n), np.zeros(n), np.zeros(n)], 1),
                         dtype=torch.float32)
     with torch.no_grad():
-        hits = cast_rays(radius, height, pose, size)
+        hits = cast_rays(Solid(radius, height, pose), size)
         texture = torch.tensor(_vase_textures(n, rng), dtype=torch.float32)  # n x 3 x 64 x 192
         color, _ = render_texture(hits, texture)
     shade = 0.35 + 0.65 * hits.normal[..., 2].abs().clamp(0, 1)  # n x size x size, light from the camera

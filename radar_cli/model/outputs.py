@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
+from typing import Callable
 
 import torch
+
+from radar_cli.render.material import Material
+from radar_cli.sor.solid import Solid
 
 
 @dataclass(frozen=True)
@@ -29,17 +33,37 @@ class Decomposition:
     alpha: torch.Tensor
     rho: torch.Tensor
 
+    @property
+    def solid(self) -> Solid:
+        """The shape and pose, as the renderer takes them."""
+        return Solid(self.radius, self.height, self.pose)
+
+    @property
+    def material(self) -> Material:
+        """The frontal albedo, the light and the gloss, as the renderer takes them."""
+        return Material(self.albedo, self.env, self.alpha, self.rho)
+
+    def tensors(self) -> tuple[torch.Tensor, ...]:
+        """Every component, in field order (for checks and comparisons over all of them)."""
+        return tuple(getattr(self, f.name) for f in fields(self))
+
+    def map(self, fn: Callable[[torch.Tensor], torch.Tensor]) -> "Decomposition":
+        """The same components with `fn` applied to each."""
+        return Decomposition(**{f.name: fn(getattr(self, f.name)) for f in fields(self)})
+
+    def combine(self, other: "Decomposition",
+                fn: Callable[[torch.Tensor, torch.Tensor], torch.Tensor]) -> "Decomposition":
+        """Each component from `fn(self's, other's)`."""
+        return Decomposition(**{f.name: fn(getattr(self, f.name), getattr(other, f.name)) for f in fields(self)})
+
     def detach(self) -> "Decomposition":
         """The same components, detached from the autograd graph."""
-        return Decomposition(*(t.detach() for t in self.as_tuple()))
+        return self.map(torch.Tensor.detach)
 
     def to(self, device: torch.device | str) -> "Decomposition":
         """The same components on another device."""
-        return Decomposition(*(t.to(device) for t in self.as_tuple()))
-
-    def as_tuple(self) -> tuple[torch.Tensor, ...]:
-        return (self.radius, self.height, self.pose, self.albedo, self.env, self.alpha, self.rho)
+        return self.map(lambda t: t.to(device))
 
     def select(self, index: int) -> "Decomposition":
         """Object `index` of the batch, as a batch of one."""
-        return Decomposition(*(t[index : index + 1] for t in self.as_tuple()))
+        return self.map(lambda t: t[index : index + 1])

@@ -16,6 +16,7 @@ from radar_cli.model.outputs import Decomposition
 from radar_cli.model.shape_net import ShapeNet
 from radar_cli.render.texture import unwrap
 from radar_cli.sor.surface import surface_grid
+from radar_cli.sor.solid import Solid
 
 
 class RadarModel(nn.Module):
@@ -33,10 +34,9 @@ class RadarModel(nn.Module):
                                   config.spec_albedo_range, config.env_range)
         self.albedo_net = AlbedoNet(config.albedo_depth, config.albedo_width, config.max_channels)
 
-    def unwrap_inputs(self, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
-                      image: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    def unwrap_inputs(self, solid: Solid, image: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """The inputs of f_A and f_L (frontal_inputs at this model's sizes and camera)."""
-        return frontal_inputs(self.config, radius, height, pose, image)
+        return frontal_inputs(self.config, solid, image)
 
     def forward(self, image: torch.Tensor) -> Decomposition:
         """De-render a batch.
@@ -49,37 +49,33 @@ class RadarModel(nn.Module):
         """
         size = self.config.render.image_size
         check_shape(image, f"B 3 {size} {size}", "image")
-        return self.read_appearance(image, *self.shape_net(image))
+        return self.read_appearance(image, Solid(*self.shape_net(image)))
 
-    def read_appearance(self, image: torch.Tensor, radius: torch.Tensor, height: torch.Tensor,
-                        pose: torch.Tensor) -> Decomposition:
+    def read_appearance(self, image: torch.Tensor, solid: Solid) -> Decomposition:
         """f_L and f_A on the texture unwrapped from `image` with the given shape and pose (f_S's, or another
         pose under test, derender.refine.pitch_search).
 
         Args:
-            image: B x 3 x H x W. radius: B x L; height: B; pose: B x 4.
+            image: B x 3 x H x W. solid: the B solids.
         """
-        geo = (radius, height, pose)
-        if self.config.detach_shape_for_texture:
-            geo = tuple(t.detach() for t in geo)
-        texture, normals = self.unwrap_inputs(*geo, image)
+        seen = solid.map(torch.Tensor.detach) if self.config.detach_shape_for_texture else solid
+        texture, normals = self.unwrap_inputs(seen, image)
         env, alpha, rho = self.light_net(texture, normals)
         albedo = self.albedo_net(texture)
-        return Decomposition(radius, height, pose, albedo, env, alpha, rho)
+        return Decomposition(solid.radius, solid.height, solid.pose, albedo, env, alpha, rho)
 
 
-def frontal_inputs(config: ModelConfig, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
-                   image: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+def frontal_inputs(config: ModelConfig, solid: Solid, image: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
     """The frontal texture unwrapped from `image` with the given shape and pose, and its normals, at the texture
     size and camera of `config`.
 
     Args:
-        image: B x 3 x H x W. radius: B x L; height: B; pose: B x 4.
+        image: B x 3 x H x W. solid: the B solids.
 
     Returns:
         texture B x 3 x Ht x Wt (as the image, tone-mapped), normals B x 3 x Ht x Wt (camera space).
     """
     size = (config.render.tex_height, config.render.tex_width)
-    texture = unwrap(radius, height, pose, image, size, config.camera)
-    grid = surface_grid(radius, height, pose, size[0], size[1], config.camera)
+    texture = unwrap(solid, image, size, config.camera)
+    grid = surface_grid(solid, size[0], size[1], config.camera)
     return texture, grid.normals.permute(0, 3, 1, 2)  # B x 3 x Ht x Wt

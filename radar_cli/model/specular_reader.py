@@ -16,6 +16,7 @@ from radar_cli.model.blocks import head
 from radar_cli.model.config import ModelConfig
 from radar_cli.model.light_net import LightNet, encoder_input, light_encoder
 from radar_cli.model.radar import frontal_inputs
+from radar_cli.sor.solid import Solid
 
 RANGE = (0.0, 1.0)  # a normalised Phong lobe with a specular albedo above 1 would send out more light than arrives
 
@@ -47,14 +48,13 @@ class SpecularReader(nn.Module):
             reader.head[2].bias.copy_(source[2].bias[1:2])
         return reader
 
-    def forward(self, image: torch.Tensor, radius: torch.Tensor, height: torch.Tensor,
-                pose: torch.Tensor) -> torch.Tensor:
+    def forward(self, image: torch.Tensor, solid: Solid) -> torch.Tensor:
         """Args:
-            image: B x 3 x H x W in [0, 1]. radius: B x L; height: B; pose: B x 4.
+            image: B x 3 x H x W in [0, 1]. solid: the B solids.
 
         Returns:
             B specular albedo in RANGE.
         """
-        texture, normals = frontal_inputs(self.config, radius, height, pose, image)
+        texture, normals = frontal_inputs(self.config, solid, image)
         z = self.encoder(encoder_input(texture, normals))  # B x latent x 1 x 1
         return RANGE[0] + (RANGE[1] - RANGE[0]) * self.head(z.flatten(1))[:, 0]

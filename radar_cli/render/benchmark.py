@@ -15,6 +15,8 @@ from radar_cli.errors import InputError
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_front, shade
 from radar_cli.render.texture import unwrap
+from radar_cli.sor.solid import Solid
+from radar_cli.render.material import Material
 
 
 @dataclass(frozen=True)
@@ -64,10 +66,11 @@ def random_inputs(batch: int, size: int, render: RenderConfig, device: torch.dev
 def render_step(x: dict, size: int, render: RenderConfig, camera: CameraConfig) -> torch.Tensor:
     """One training-like render: soft silhouette, shaded frontal texture drawn into the image, unwrap of the
     input image. Returns a scalar loss touching every output."""
-    hits = cast_rays(x["radius"], x["height"], x["pose"], size, camera, render.sil_sigma_px)
-    shading = shade(x["radius"], x["height"], x["pose"], x["albedo"], x["env"], x["alpha"], x["rho"], render, camera)
+    solid = Solid(x["radius"], x["height"], x["pose"])
+    hits = cast_rays(solid, size, camera, render.sil_sigma_px)
+    shading = shade(solid, Material(x["albedo"], x["env"], x["alpha"], x["rho"]), render, camera)
     image, mask = render_front(hits, shading.texture)
-    tex = unwrap(x["radius"], x["height"], x["pose"], x["image"], tuple(x["albedo"].shape[-2:]), camera)
+    tex = unwrap(solid, x["image"], tuple(x["albedo"].shape[-2:]), camera)
     return (hits.sil - 0.5).square().mean() + ((image - x["image"]) * mask).abs().mean() + tex.mean()
 
 

@@ -22,6 +22,7 @@ from radar_cli.sor.pose import rotation_matrix, translation
 from radar_cli.errors import InputError
 from radar_cli.render.intersect import Found, search
 from radar_cli.sor.profile import check_sor, row_coordinate, row_slopes
+from radar_cli.sor.solid import Solid
 
 CULL_SIGMAS = 6.0  # rays farther than this many sigmas from the bounding cylinder are not cast (sil = 0)
 HIT_SIGMAS = 0.01  # the margin when only hits are wanted (soft_outside=False): against rounding at the rim
@@ -106,9 +107,7 @@ def object_rays(pose: torch.Tensor, size: int, camera: CameraConfig = CameraConf
 
 
 def cast_rays(
-    radius: torch.Tensor,
-    height: torch.Tensor,
-    pose: torch.Tensor,
+    solid: Solid,
     size: int,
     camera: CameraConfig = CameraConfig(),
     sigma_px: float = 1.0,
@@ -117,9 +116,8 @@ def cast_rays(
     """Cast one ray per pixel at a batch of solids of revolution.
 
     Args:
-        radius: B x L radius column, fractions of r_max (row 0 = top).
-        height: B half-heights, fractions of r_max.
-        pose: B x 4 (pitch deg, roll deg, tx, ty as fractions of r_max).
+        solid: B solids (radius B x L, row 0 = top; height B; pose B x 4 pitch deg, roll deg, tx, ty; lengths in
+            fractions of r_max).
         size: image side in pixels.
         camera: the fixed camera.
         sigma_px: softness of the soft silhouette in pixels.
@@ -130,6 +128,7 @@ def cast_rays(
     Returns:
         Hits with H = W = size.
     """
+    radius, height, pose = solid.radius, solid.height, solid.pose
     check_sor(radius, height, pose)
     if not (isinstance(size, int) and size >= 1) or not (math.isfinite(sigma_px) and sigma_px > 0):
         raise InputError(f"size must be >= 1 and sigma_px > 0, got size={size}, sigma_px={sigma_px}")

@@ -16,11 +16,13 @@ import torch.nn.functional as F
 
 from radar_cli.checks import check_shape
 from radar_cli.config import CameraConfig, RenderConfig
+from radar_cli.render.material import Material
 from radar_cli.render.lighting import check_material, compose, decompose, shading_factors, upsample
 from radar_cli.render.raycast import Hits, cast_rays
 from radar_cli.render.texture import render_texture, unwrap
 from radar_cli.sor.profile import check_sor
 from radar_cli.sor.surface import FRONT_SPAN, FULL_SPAN, surface_grid
+from radar_cli.sor.solid import Solid
 
 
 @dataclass(frozen=True)
@@ -48,13 +50,8 @@ class Shading:
 
 
 def shade(
-    radius: torch.Tensor,
-    height: torch.Tensor,
-    pose: torch.Tensor,
-    albedo: torch.Tensor,
-    env: torch.Tensor,
-    alpha: torch.Tensor,
-    rho: torch.Tensor,
+    solid: Solid,
+    material: Material,
     render: RenderConfig = RenderConfig(),
     camera: CameraConfig = CameraConfig(),
     span: float = FRONT_SPAN,
@@ -65,23 +62,24 @@ def shade(
     upsampled bilinearly to the albedo's size, as the original implementation does.
 
     Args:
-        radius: B x L radius column; height: B; pose: B x 4 (see cast_rays).
-        albedo: B x 3 x Ht x Wt linear albedo in [0, 1]; the frontal third if span = FRONT_SPAN, the whole
-            360 deg map (column 0 at the back, -180 deg) if span = FULL_SPAN.
-        env: B x He x We environment map (>= 0), camera frame.
-        alpha: B shininess; rho: B specular albedo.
+        solid: B solids (see cast_rays).
+        material: albedo B x 3 x Ht x Wt linear in [0, 1], the frontal third if span = FRONT_SPAN, the whole
+            360 deg map (column 0 at the back, -180 deg) if span = FULL_SPAN; env B x He x We (>= 0), camera
+            frame; alpha B shininess; rho B specular albedo.
         span: half-width in radians of the angular range the albedo covers.
 
     Returns:
         Shading at the albedo's resolution.
     """
+    radius, height, pose = solid.radius, solid.height, solid.pose
+    albedo, env, alpha, rho = material.albedo, material.env, material.alpha, material.rho
     check_sor(radius, height, pose)
     dims = check_shape(albedo, "B 3 Ht Wt", "albedo", {"B": radius.shape[0]})
     check_shape(env, "B He We", "env", dims)
     check_material(alpha, rho, env)
     rows = render.shading_height
     cols = max(1, round(render.shading_width * span / FRONT_SPAN))
-    grid = surface_grid(radius, height, pose, rows, cols, camera, span)
+    grid = surface_grid(solid, rows, cols, camera, span)
     diffuse, specular = shading_factors(grid.normals, grid.view, env, alpha)  # B x rows x cols each
     size = (dims["Ht"], dims["Wt"])
     diffuse = upsample(diffuse[:, None], size)
@@ -104,26 +102,21 @@ def render_front(hits: Hits, texture: torch.Tensor, background: float = 0.0) -> 
 
 
 def render_frontal(
-    radius: torch.Tensor,
-    height: torch.Tensor,
-    pose: torch.Tensor,
-    albedo: torch.Tensor,
-    env: torch.Tensor,
-    alpha: torch.Tensor,
-    rho: torch.Tensor,
+    solid: Solid,
+    material: Material,
     render: RenderConfig,
     camera: CameraConfig,
 ) -> tuple[Hits, Shading, torch.Tensor, torch.Tensor]:
     """A prediction drawn as the training's losses see it: ray-cast, shade the frontal third, render it.
 
     Args:
-        radius: B x L; height: B; pose: B x 4. albedo: B x 3 x Ht x Wt frontal, linear. env: B x He x We.
+        solid: B solids. material: its albedo B x 3 x Ht x Wt the frontal third, linear.
 
     Returns:
         (hits, shading, I^ B x 3 x H x W, S^_f B x 1 x H x W).
     """
-    hits = cast_rays(radius, height, pose, render.image_size, camera, render.sil_sigma_px)
-    shading = shade(radius, height, pose, albedo, env, alpha, rho, render, camera)
+    hits = cast_rays(solid, render.image_size, camera, render.sil_sigma_px)
+    shading = shade(solid, material, render, camera)
     recon, front = render_front(hits, shading.texture)
     return hits, shading, recon, front
 
@@ -135,9 +128,7 @@ training vases among 0.5-1.0 (albedo si-MSE x 1e-2: 0.5 2.65, 0.7 2.42, 0.8 2.40
 
 def divide_shading(
     image: torch.Tensor,
-    radius: torch.Tensor,
-    height: torch.Tensor,
-    pose: torch.Tensor,
+    solid: Solid,
     albedo: torch.Tensor,
     rho: torch.Tensor,
     shading: Shading,
@@ -152,7 +143,7 @@ def divide_shading(
 
     Args:
         image: B x 3 x S x S tone-mapped image in [0, 1].
-        radius: B x L; height: B; pose: B x 4 (the predicted shape and pose).
+        solid: the predicted shape and pose of B objects.
         albedo: B x 3 x Ht x Wt the predicted albedo, the fallback off the object.
         rho: B predicted specular albedo.
         shading: `shade` of that prediction over the frontal third (the caller usually has it already).
@@ -165,7 +156,7 @@ def divide_shading(
         B x 3 x Ht x Wt linear albedo in [0, 1].
     """
     stacked = image if silhouette is None else torch.cat([image, silhouette], dim=1)  # B x (3 or 4) x S x S
-    unwrapped = unwrap(radius, height, pose, stacked, (render.tex_height, render.tex_width), camera)
+    unwrapped = unwrap(solid, stacked, (render.tex_height, render.tex_width), camera)
     divided = decompose(unwrapped[:, :3], shading.diffuse, shading.specular, rho, render.gamma, max_specular_share)
     if silhouette is None:
         return divided
@@ -174,13 +165,8 @@ def divide_shading(
 
 
 def render_synthetic(
-    radius: torch.Tensor,
-    height: torch.Tensor,
-    pose: torch.Tensor,
-    albedo_full: torch.Tensor,
-    env: torch.Tensor,
-    alpha: torch.Tensor,
-    rho: torch.Tensor,
+    solid: Solid,
+    material: Material,
     size: int,
     render: RenderConfig,
     camera: CameraConfig,
@@ -191,26 +177,26 @@ def render_synthetic(
     halo outside the object). Synthesis and the training's two cycles draw through this.
 
     Args:
-        radius: B x L; height: B; pose: B x 4.
-        albedo_full: B x 3 x Ht x 3Wt linear 360 deg albedo. env: B x He x We; alpha, rho: B.
+        solid: B solids.
+        material: its albedo B x 3 x Ht x 3Wt the linear 360 deg map.
         size: image side in pixels. background: a grey level, or B x 3 x 1 x 1 colours.
 
     Returns:
         (image B x 3 x H x W tone-mapped, the hits (soft silhouette on the object only), the shading).
     """
-    image, hard, hits, shading = _draw_whole(radius, height, pose, albedo_full, env, alpha, rho, size, render,
+    image, hard, hits, shading = _draw_whole(solid, material, size, render,
                                              camera, background, soft_outside=False)
     return image * hard + background * (1 - hard), hits, shading
 
 
-def _draw_whole(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, albedo_full: torch.Tensor,
-                env: torch.Tensor, alpha: torch.Tensor, rho: torch.Tensor, size: int, render: RenderConfig,
+def _draw_whole(solid: Solid, material: Material,
+                size: int, render: RenderConfig,
                 camera: CameraConfig, background: float | torch.Tensor,
                 soft_outside: bool) -> tuple[torch.Tensor, torch.Tensor, Hits, Shading]:
     """Shade a 360 deg albedo, cast the rays (cast_rays' soft_outside) and draw the whole object, inside dimmed:
     (image B x 3 x H x W over `background` by the soft silhouette, that coverage B x 1 x H x W, hits, shading)."""
-    shading = shade(radius, height, pose, albedo_full, env, alpha, rho, render, camera, span=FULL_SPAN)
-    hits = cast_rays(radius, height, pose, size, camera, render.sil_sigma_px, soft_outside=soft_outside)
+    shading = shade(solid, material, render, camera, span=FULL_SPAN)
+    hits = cast_rays(solid, size, camera, render.sil_sigma_px, soft_outside=soft_outside)
     image, coverage = render_texture(hits, shading.texture, front_only=False, inside_dim=render.inside_dim,
                                      background=background)
     return image, coverage, hits, shading
@@ -229,13 +215,8 @@ def rotate_full_map(texture: torch.Tensor, yaw_deg: float) -> torch.Tensor:
 
 
 def render_view(
-    radius: torch.Tensor,
-    height: torch.Tensor,
-    pose: torch.Tensor,
-    albedo_full: torch.Tensor,
-    env: torch.Tensor,
-    alpha: torch.Tensor,
-    rho: torch.Tensor,
+    solid: Solid,
+    material: Material,
     size: int,
     yaw_deg: float = 0.0,
     render: RenderConfig = RenderConfig(),
@@ -248,16 +229,17 @@ def render_view(
     The inside of an open vase is drawn dimmed by render.inside_dim.
 
     Args:
-        radius: B x L; height: B; pose: B x 4.
-        albedo_full: B x 3 x Ht x 3Wt linear 360 deg albedo (middle third = the frontal view at yaw 0).
-        env: B x He x We; alpha, rho: B.
+        solid: B solids.
+        material: its albedo B x 3 x Ht x 3Wt the linear 360 deg map (middle third = the frontal view at yaw 0).
         size: output image side in pixels.
 
     Returns:
         (image B x 3 x H x W tone-mapped over `background`, mask B x 1 x H x W float coverage).
     """
+    radius = solid.radius
+    albedo_full = material.albedo
     check_shape(albedo_full, "B 3 Ht Wt", "albedo_full", {"B": radius.shape[0]})
-    image, _, hits, _ = _draw_whole(radius, height, pose, rotate_full_map(albedo_full, yaw_deg), env, alpha, rho,
+    image, _, hits, _ = _draw_whole(solid, material.with_albedo(rotate_full_map(albedo_full, yaw_deg)),
                                     size, render, camera, background, soft_outside=True)
     return image, hits.sil[:, None]
 

@@ -15,6 +15,7 @@ from radar_cli.render.raycast import Hits
 from radar_cli.sor.camera import project
 from radar_cli.sor.profile import check_sor
 from radar_cli.sor.surface import FRONT_SPAN, SurfaceGrid, surface_grid
+from radar_cli.sor.solid import Solid
 
 
 def front_third(texture: torch.Tensor) -> torch.Tensor:
@@ -75,9 +76,7 @@ def render_texture(
 
 
 def unwrap(
-    radius: torch.Tensor,
-    height: torch.Tensor,
-    pose: torch.Tensor,
+    solid: Solid,
     image: torch.Tensor,
     tex_size: tuple[int, int],
     camera: CameraConfig = CameraConfig(),
@@ -88,18 +87,19 @@ def unwrap(
     Differentiable in the image, the shape and the pose.
 
     Args:
-        radius: B x L, height: B, pose: B x 4 (see cast_rays).
+        solid: B solids (see cast_rays).
         image: B x C x H x W.
         tex_size: (Ht, Wt) of the frontal texture.
 
     Returns:
         B x C x Ht x Wt frontal texture.
     """
+    radius, height, pose = solid.radius, solid.height, solid.pose
     check_sor(radius, height, pose)
     check_shape(image, "B C H W", "image", {"B": radius.shape[0]})
     check_finite(image, "image")
     rows, cols = tex_size
-    return sample_surface(image, surface_grid(radius, height, pose, rows, cols, camera), camera)
+    return sample_surface(image, surface_grid(solid, rows, cols, camera), camera)
 
 
 def sample_surface(image: torch.Tensor, grid: SurfaceGrid, camera: CameraConfig = CameraConfig()) -> torch.Tensor:

@@ -18,6 +18,7 @@ import torch
 from radar_cli.config import CameraConfig
 from radar_cli.sor.pose import rotation_matrix, translation
 from radar_cli.sor.profile import radius_at
+from radar_cli.sor.solid import Solid
 
 SUBROWS_PER_PIXEL = 0.5  # discs sampled along the axis per image row (the axis spans at most 2 image heights)
 
@@ -37,18 +38,19 @@ class Outline:
     bottom: torch.Tensor
 
 
-def disc_frames(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, n_discs: int,
+def disc_frames(solid: Solid, n_discs: int,
                 camera: CameraConfig) -> torch.Tensor:
     """The maps from the unit circle to the image of n_discs discs evenly spaced along the axis (top to bottom):
     disc k's rim point at angle t is g_k (cos t, sin t, 1), in homogeneous normalised image coordinates (x right,
     y up, both tan(fov/2) = 1).
 
     Args:
-        radius: B x L radius column; height: B; pose: B x 4 (as cast_rays). Computed in float64.
+        solid: B solids (as cast_rays). Computed in float64.
 
     Returns:
         B x n_discs x 3 x 3.
     """
+    radius, height, pose = solid.radius, solid.height, solid.pose
     dt = torch.float64
     radius, height, pose = radius.to(dt), height.to(dt), pose.to(dt)
     v = torch.linspace(-1.0, 1.0, n_discs, dtype=dt, device=radius.device)  # -1 = top
@@ -66,18 +68,18 @@ def disc_frames(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, 
 UNIT_CIRCLE = torch.diag(torch.tensor([1.0, 1.0, -1.0], dtype=torch.float64))  # x^2 + y^2 - 1 = 0, self-dual
 
 
-def disc_conics(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, n_discs: int,
+def disc_conics(solid: Solid, n_discs: int,
                 camera: CameraConfig) -> torch.Tensor:
     """The image conics of n_discs discs evenly spaced along the axis (top to bottom), in normalised image
     coordinates (x right, y up, both tan(fov/2) = 1): point m = (x, y, 1) is on disc k's ellipse iff m^T Q_k m = 0.
 
     Args:
-        radius: B x L radius column; height: B; pose: B x 4 (as cast_rays). Computed in float64.
+        solid: B solids (as cast_rays). Computed in float64.
 
     Returns:
         B x n_discs x 3 x 3 symmetric conics, each scaled to unit norm.
     """
-    return _conics(disc_frames(radius, height, pose, n_discs, camera))
+    return _conics(disc_frames(solid, n_discs, camera))
 
 
 def _conics(g: torch.Tensor) -> torch.Tensor:
@@ -87,14 +89,14 @@ def _conics(g: torch.Tensor) -> torch.Tensor:
     return q / q.flatten(-2).norm(dim=-1)[..., None, None]
 
 
-def vertical_extent(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, size: int,
+def vertical_extent(solid: Solid, size: int,
                     camera: CameraConfig = CameraConfig(), n_discs: int | None = None,
                     margin: int = 3) -> tuple[torch.Tensor, torch.Tensor]:
     """The silhouette's top and bottom rows in an S x S image, as sampled by outline() (the least of its columns'
     tops and the greatest of their bottoms, pixel-centre coordinates; B each), computed only on the columns
     within `margin` of the extremes: each disc's extreme is in closed form from its dual conic g D g^T (the
     horizontal lines y = c tangent to it), which places them. Far cheaper than the full outline."""
-    g = disc_frames(radius, height, pose, n_discs or n_discs_for(size), camera)  # B x K x 3 x 3
+    g = disc_frames(solid, n_discs or n_discs_for(size), camera)  # B x K x 3 x 3
     with torch.no_grad():
         dual = g @ UNIT_CIRCLE.to(g.device) @ g.transpose(-1, -2)
         low, high = _tangent_heights(dual)  # B x K normalised y, up; line (0, 1, -c) touches at dual @ (0, 1, -c)
@@ -253,18 +255,18 @@ def _extreme(values: torch.Tensor, reduce, fill: float) -> torch.Tensor:
 SWAP_XY = torch.tensor([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]], dtype=torch.float64)
 
 
-def outline(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, size: int,
+def outline(solid: Solid, size: int,
             camera: CameraConfig = CameraConfig(), n_discs: int | None = None) -> Outline:
     """The silhouette's ends along every row and column of an S x S image.
 
     Args:
-        radius: B x L; height: B; pose: B x 4 (see cast_rays). size: S. n_discs: discs sampled along the axis
+        solid: B solids (see cast_rays). size: S. n_discs: discs sampled along the axis
             (default n_discs_for(size)).
 
     Returns:
         Outline in pixel-centre coordinates (float64).
     """
-    q = disc_conics(radius, height, pose, n_discs or n_discs_for(size), camera)  # B x K x 3 x 3
+    q = disc_conics(solid, n_discs or n_discs_for(size), camera)  # B x K x 3 x 3
     first, step = 1.0 / size - 1.0, 2.0 / size  # pixel centres, normalised
     left, right = _row_ends(q, (-first, -step, size))  # rows: normalised y = -c (up)
     swap = SWAP_XY.to(q.device)

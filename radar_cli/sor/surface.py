@@ -14,6 +14,7 @@ import torch
 from radar_cli.config import CameraConfig
 from radar_cli.sor.pose import directions_to_camera, object_to_camera
 from radar_cli.sor.profile import radius_at, slope_at
+from radar_cli.sor.solid import Solid
 
 FRONT_SPAN = math.pi / 3.0  # the frontal third: phi in [-60, 60] deg around the direction facing the camera
 FULL_SPAN = math.pi
@@ -40,9 +41,7 @@ def grid_centres(n: int, device=None, dtype=torch.float32) -> torch.Tensor:
 
 
 def surface_grid(
-    radius: torch.Tensor,
-    height: torch.Tensor,
-    pose: torch.Tensor,
+    solid: Solid,
     rows: int,
     cols: int,
     camera: CameraConfig = CameraConfig(),
@@ -51,12 +50,13 @@ def surface_grid(
     """Sample the surface of revolution on a regular grid.
 
     Args:
-        radius: B x L radius column (fractions of r_max). height: B. pose: B x 4.
+        solid: B solids (radius B x L in fractions of r_max, height B, pose B x 4).
         rows, cols: grid size. span: half-width of the angular range in radians.
 
     Returns:
         SurfaceGrid of B x rows x cols x 3 tensors.
     """
+    radius, height, pose = solid.radius, solid.height, solid.pose
     n_batch, dev, dt = radius.shape[0], radius.device, radius.dtype
     v = grid_centres(rows, dev, dt).expand(n_batch, rows)  # B x rows
     phi = grid_centres(cols, dev, dt) * span  # cols

@@ -16,6 +16,8 @@ from radar_cli.config import CameraConfig, RenderConfig
 from radar_cli.render.lighting import TINY, power, tone_map
 from radar_cli.render.scene import render_synthetic
 from radar_cli.render.texture import render_texture
+from radar_cli.sor.solid import Solid
+from radar_cli.render.material import Material
 
 
 @dataclass(frozen=True)
@@ -81,7 +83,7 @@ def render_sample(
     e = torch.from_numpy(np.asarray(env, dtype=np.float32))[None]  # 1 x He x We
     a, p = torch.tensor([alpha], dtype=torch.float32), torch.tensor([rho], dtype=torch.float32)
 
-    image, hits, shading = render_synthetic(r, h, v, linear, e, a, p, size, render, camera, background)
+    image, hits, shading = render_synthetic(Solid(r, h, v), Material(linear, e, a, p), size, render, camera, background)
     albedo_img, _ = render_texture(hits, display, inside_dim=1.0, background=0.0)
     maps = torch.cat([shading.diffuse, shading.specular], dim=1)  # 1 x 2 x Ht x 3Wt
     maps_img, _ = render_texture(hits, maps, inside_dim=1.0, background=0.0)

@@ -30,6 +30,7 @@ from radar_cli.model.weights import load_model, read_specular_reader
 from radar_cli.train.checkpoint import optimizer_tensors, restore_optimizer, save_specular_reader
 from radar_cli.train.data import VaseDataset
 from radar_cli.train.logging import loss_curve
+from radar_cli.sor.solid import Solid
 
 READER_FILE = "specular_reader.safetensors"
 LAST_FILE = "last.safetensors"
@@ -110,7 +111,7 @@ class _Split:
     def read(self, reader: SpecularReader, index: torch.Tensor) -> torch.Tensor:
         """The reader's specular albedo of the samples `index` (B)."""
         image = self.image.index_select(0, index).float() / 255.0
-        return reader(image, self.radius[index], self.height[index], self.pose[index])
+        return reader(image, Solid(self.radius[index], self.height[index], self.pose[index]))
 
     def score(self, reader: SpecularReader, batch_size: int) -> tuple[float, float]:
         """(mean |error| of the reader, of the best constant guess) over the split."""

@@ -20,6 +20,7 @@ from radar_cli.render.mouth import coverage, coverage_above, mouth_margin
 from radar_cli.render.raycast import Hits
 from radar_cli.render.scene import Shading, divide_shading, render_front, render_frontal, render_synthetic
 from radar_cli.render.texture import full_from_front
+from radar_cli.sor.solid import Solid
 
 
 @dataclass(frozen=True)
@@ -70,7 +71,7 @@ def output_ranges(config: RunConfig) -> dict[str, tuple[float, float]]:
 
 def render_prediction(pred: Decomposition, config: RunConfig) -> tuple[Hits, Shading, torch.Tensor, torch.Tensor]:
     """Ray-cast, shade and render the frontal third of a prediction: (hits, shading, I^, S^_f)."""
-    return render_frontal(*pred.as_tuple(), config.model.render, config.model.camera)
+    return render_frontal(pred.solid, pred.material, config.model.render, config.model.camera)
 
 
 def _mouth_term(pred: Decomposition, hits: Hits, recon_mu: torch.Tensor, front: torch.Tensor, batch: Batch,
@@ -111,8 +112,9 @@ def redraw(pred: Decomposition, pose: torch.Tensor, background: torch.Tensor, co
         B x 3 x H x W tone-mapped image in [0, 1].
     """
     m = config.model
-    image, _, _ = render_synthetic(pred.radius, pred.height, pose, full_from_front(pred.albedo), pred.env,
-                                   pred.alpha, pred.rho, m.render.image_size, m.render, m.camera, background)
+    solid = Solid(pred.radius, pred.height, pose)
+    material = pred.material.with_albedo(full_from_front(pred.albedo))
+    image, _, _ = render_synthetic(solid, material, m.render.image_size, m.render, m.camera, background)
     return (image.clamp(0.0, 1.0) * 255).round() / 255
 
 
@@ -138,7 +140,7 @@ def divided_prediction(pred: Decomposition, shading: Shading, batch: Batch, conf
     the cycles redraw with under loss.cycle_albedo = "divided"."""
     m = config.model
     target = pred.detach()
-    albedo = divide_shading(batch.image, target.radius, target.height, target.pose, target.albedo, target.rho,
+    albedo = divide_shading(batch.image, target.solid, target.albedo, target.rho,
                             shading, m.render, m.camera, batch.mask[:, None])
     return dataclasses.replace(target, albedo=albedo)
 
@@ -166,7 +168,7 @@ def light_cycle_term(model: RadarModel, pred: Decomposition, background: torch.T
     lo, hi = config.model.shininess_range
     target = relit(detached, lo + (hi - lo) * torch.rand(detached.alpha.shape[0]).to(detached.alpha))
     image = redraw(target, target.pose, background, config)
-    texture, normals = model.unwrap_inputs(target.radius, target.height, target.pose, image)
+    texture, normals = model.unwrap_inputs(target.solid, image)
     env, alpha, rho = model.light_net(texture, normals)
     terms = L.material_l1((model.albedo_net(texture), env, alpha, rho),
                           (target.albedo, target.env, target.alpha, target.rho), output_ranges(config))

@@ -103,7 +103,7 @@ def train_step(state: TrainState, model: torch.nn.Module, disc: torch.nn.Module,
         pred = model(batch.image)
     except InputError as e:  # the geometry checks inside forward reject NaN shapes before we see them
         raise _diverged(step, f"invalid network output ({e})", run_dir) from None
-    _finite_or_stop(torch.stack([t.sum() for t in pred.as_tuple()]), "a network output", step, info, run_dir)
+    _finite_or_stop(torch.stack([t.sum() for t in pred.tensors()]), "a network output", step, info, run_dir)
     bare_disc = D.unwrap(disc)
     terms, rendered = generator_losses(pred, batch, config, bare_disc if uses_sad(config) else None,
                                        state.model)

@@ -14,6 +14,7 @@ from radar_cli.derender.refine.pitch_search import PitchSearch, _grid_scores, pa
 from radar_cli.model.losses import distance_transform
 from radar_cli.derender.run.predictor import ASSETS, Predictor
 from radar_cli.errors import InputError
+from radar_cli.sor.solid import Solid
 
 from .test_predictor import save_weights, tiny_config
 
@@ -57,7 +58,7 @@ def test_search_finds_the_pitch_a_silhouette_was_drawn_at() -> None:
             pose = first.pose.clone()
             pose[:, 0] = true_pitch
             with torch.no_grad():
-                sil = cast_rays(first.radius, first.height, pose, 64, cfg.camera, cfg.render.sil_sigma_px).sil
+                sil = cast_rays(Solid(first.radius, first.height, pose), 64, cfg.camera, cfg.render.sil_sigma_px).sil
             found = search_pitch(model, image, [sil[0].numpy() > 0.5], first, outline_only)
             assert torch.equal(found.radius, first.radius) and torch.equal(found.pose[:, 1:], first.pose[:, 1:])
             searched.append(abs(found.pose[0, 0].item() - true_pitch))

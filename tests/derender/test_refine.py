@@ -23,10 +23,10 @@ class Appearance:
     def __init__(self, rho: float = 0.3):
         self.rho = rho
 
-    def read_appearance(self, image, radius, height, pose):
-        b = radius.shape[0]
-        return Decomposition(radius, height, pose, torch.full((b, 3, 8, 8), 0.5), torch.ones(b, 4, 12),
-                             torch.full((b,), 20.0), torch.full((b,), self.rho))
+    def read_appearance(self, image, solid):
+        b = solid.batch
+        return Decomposition(solid.radius, solid.height, solid.pose, torch.full((b, 3, 8, 8), 0.5),
+                             torch.ones(b, 4, 12), torch.full((b,), 20.0), torch.full((b,), self.rho))
 
 
 def _sample(index: int):
@@ -94,7 +94,7 @@ def test_lighting_fit_runs_after_the_shape_and_repeats_bit_for_bit():
         assert report.light_rmse[0] < report.light_rmse[1]
     else:
         assert torch.equal(first.env, start.env)
-    for a, b in zip(first.as_tuple(), second.as_tuple()):
+    for a, b in zip(first.tensors(), second.tensors()):
         assert torch.equal(a, b)
 
 
@@ -122,8 +122,8 @@ def test_the_reader_reads_the_specular_albedo_at_the_fitted_shape():
     start = _perturbed(params, 2.0, 1.05)
     seen = []
 
-    def reader(network_input, radius, height, pose):
-        seen.append(float(pose[0, 0]))
+    def reader(network_input, solid):
+        seen.append(float(solid.pose[0, 0]))
         return torch.tensor([0.42])
 
     refined, report = refine_object(Appearance(rho=1.6), torch.zeros(1, 3, 64, 64), start, image, mask,

@@ -21,6 +21,7 @@ from radar_cli.derender.export.renders import ViewRenderer
 from radar_cli.derender.run.state import read_state
 from radar_cli.errors import InputError
 from radar_cli.render.scene import render_view
+from radar_cli.sor.solid import Solid
 
 from .conftest import SIZE, write_photo
 
@@ -77,9 +78,9 @@ def test_view_renderer_equals_render_view(obj: Path) -> None:
     state = read_state(obj)
     view = ViewRenderer(state, 40, pitch_deg=5.0)
     fast = view.draw(view.shading(), yaw_deg=100.0).astype(np.float64)
-    pose = state.pose.clone()
+    pose = state.solid.pose.clone()
     pose[:, 0] = 5.0
-    ref, _ = render_view(state.radius, state.height, pose, state.albedo, state.env, state.alpha, state.rho, 40,
+    ref, _ = render_view(Solid(state.solid.radius, state.solid.height, pose), state.material, 40,
                          100.0, state.render, state.camera, 1.0)
     ref8 = np.clip(ref[0].permute(1, 2, 0).numpy(), 0, 1) * 255
     assert np.abs(fast - ref8).max() <= 1.0

@@ -126,8 +126,8 @@ def test_divided_albedo_at_the_output_side_draws_the_crop_back(tmp_path: Path) -
     dec = predictor.predict([prepared.image], [prepared.silhouette])
     divided = full_resolution_state(dec, prepared, SETUP, "divided")
     network = full_resolution_state(dec, prepared, SETUP, "network")
-    assert divided.albedo.shape == network.albedo.shape == (1, 3, SIDE, 3 * SIDE)
-    assert divided.radius.shape == (1, PROFILE_ROWS)
+    assert divided.material.albedo.shape == network.material.albedo.shape == (1, 3, SIDE, 3 * SIDE)
+    assert divided.solid.radius.shape == (1, PROFILE_ROWS)
 
     def median_error(state) -> float:
         view = ViewRenderer(state, SIDE)

@@ -141,9 +141,9 @@ def test_mean_colour_render_matches_compose(setup):
     config, model, _, batch = setup
     with torch.no_grad():
         d = model(batch.image)
-        sh = shade(d.radius, d.height, d.pose, d.albedo, d.env, d.alpha, d.rho, config.model.render)
+        sh = shade(d.solid, d.material, config.model.render)
         tex = compose(L.mean_color(d.albedo), sh.diffuse, sh.specular, d.rho)
-        hits = cast_rays(d.radius, d.height, d.pose, 32)
+        hits = cast_rays(d.solid, 32)
         img, front = render_front(hits, tex)
     assert img.shape == (4, 3, 32, 32) and front.shape == (4, 1, 32, 32)
     assert torch.allclose(tone_map(d.albedo.mean(dim=(2, 3))[..., None, None] * sh.diffuse
@@ -158,7 +158,7 @@ def test_supervised_loss_zero_on_truth(setup):
     terms = L.supervised_loss(d, d, output_ranges(config))
     assert all(v.item() == 0 for v in terms.values())
     d2 = model(batch.image)
-    other = type(d)(*(t.detach() * 0.9 for t in d.as_tuple()))
+    other = d.map(lambda t: t.detach() * 0.9)
     total = sum(L.supervised_loss(d2, other, output_ranges(config)).values())
     total.backward()
     assert _grads(model.shape_net) and _grads(model.light_net) and _grads(model.albedo_net)

@@ -17,6 +17,8 @@ from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_front, render_view, shade
 from radar_cli.synth.shapes import sample_shape
 from radar_cli.train.step import generator_losses
+from radar_cli.sor.solid import Solid
+from radar_cli.render.material import Material
 
 from .conftest import box_batch, tiny_config
 
@@ -33,7 +35,7 @@ def _vase(seed: int, pitch: float):
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_coverage_is_the_rays_that_enter_the_mouth(seed):
     radius, height, pose = _vase(seed, 15.0)
-    inner = cast_rays(radius, height, pose, 96).inner[0]
+    inner = cast_rays(Solid(radius, height, pose), 96).inner[0]
     cover = mouth_coverage(radius, height, pose, 96)[0]
     assert inner.sum() > 20
     assert ((cover > 0.5) == inner).float().mean() > 0.998
@@ -46,13 +48,13 @@ def test_mouth_term_pulls_pitch_towards_the_truth_from_both_sides():
     env = torch.full((1, 8, 24), 0.3)
     alpha, rho = torch.tensor([20.0]), torch.tensor([0.2])
     with torch.no_grad():
-        image, cover = render_view(radius, height, pose, albedo, env, alpha, rho, 64, render=RENDER)
+        image, cover = render_view(Solid(radius, height, pose), Material(albedo, env, alpha, rho), 64, render=RENDER)
     mask = (cover > 0.5).float()
     for guess, sign in ((7.0, -1.0), (17.0, 1.0)):
         pitch = torch.tensor([guess], requires_grad=True)
         pred_pose = torch.cat([pitch[:, None], torch.zeros(1, 3)], dim=1)
-        hits = cast_rays(radius, height, pred_pose, 64)
-        shading = shade(radius, height, pred_pose, albedo[..., 32:64], env, alpha, rho, RENDER)
+        hits = cast_rays(Solid(radius, height, pred_pose), 64)
+        shading = shade(Solid(radius, height, pred_pose), Material(albedo[..., 32:64], env, alpha, rho), RENDER)
         recon_mu, front = render_front(hits, compose(albedo[..., 32:64], shading.diffuse, shading.specular, rho))
         mouth = mouth_coverage(radius, height, pred_pose, 64)[:, None]
         region = mask * torch.maximum(front, hits.inner[:, None].float()).detach()

@@ -10,6 +10,7 @@ import torch
 from radar_cli.model.losses import distance_transform, silhouette_loss
 from radar_cli.render.raycast import cast_rays
 from radar_cli.synth.shapes import sample_shape
+from radar_cli.sor.solid import Solid
 
 SIZE = 64
 PITCHES = np.arange(0.0, 20.01, 1.0)
@@ -23,12 +24,12 @@ def argmin_pitch_errors(sigma_px: float, margin_px: float, n: int = 12) -> np.nd
         radius = torch.tensor(np.asarray(shape.radius), dtype=torch.float32)[None]
         height = torch.tensor([shape.height], dtype=torch.float32)
         with torch.no_grad():
-            target = cast_rays(radius, height, torch.tensor([shape.pose], dtype=torch.float32), SIZE).mask
+            target = cast_rays(Solid(radius, height, torch.tensor([shape.pose], dtype=torch.float32)), SIZE).mask
             dt = torch.from_numpy(distance_transform(target[0].numpy()))[None]
             losses = []
             for pitch in PITCHES:
                 pose = torch.tensor([[pitch, *shape.pose[1:]]], dtype=torch.float32)
-                sil = cast_rays(radius, height, pose, SIZE, sigma_px=sigma_px).sil
+                sil = cast_rays(Solid(radius, height, pose), SIZE, sigma_px=sigma_px).sil
                 losses.append(float(silhouette_loss(sil, target.float(), dt, 10.0, 100.0, margin_px)))
         errors.append(PITCHES[int(np.argmin(losses))] - shape.pose[0])
     return np.asarray(errors)

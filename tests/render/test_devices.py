@@ -12,6 +12,8 @@ import torch
 
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_view, shade
+from radar_cli.render.material import Material
+from radar_cli.sor.solid import Solid
 
 
 @pytest.mark.gpu
@@ -24,10 +26,11 @@ def test_cpu_and_cuda_agree(random_sor):
     alpha, rho = torch.tensor([5.0, 20.0, 60.0, 150.0]), torch.tensor([0.2, 0.5, 0.8, 1.0])
     outputs = {}
     for dev in ("cpu", "cuda"):
-        args = [t.to(dev) for t in (radius, height, pose)]
-        hits = cast_rays(*args, 128)
-        image, _ = render_view(*args, albedo.to(dev), env.to(dev), alpha.to(dev), rho.to(dev), 128)
-        front = shade(*args, albedo[..., 32:64].to(dev), env.to(dev), alpha.to(dev), rho.to(dev))
+        solid = Solid(radius, height, pose).map(lambda t: t.to(dev))
+        material = Material(albedo, env, alpha, rho).map(lambda t: t.to(dev))
+        hits = cast_rays(solid, 128)
+        image, _ = render_view(solid, material, 128)
+        front = shade(solid, material.with_albedo(albedo[..., 32:64].to(dev)))
         outputs[dev] = [hits.sil, hits.depth, hits.normal, image, front.texture]
     names = ("sil", "depth", "normal", "image", "texture")
     report = {}

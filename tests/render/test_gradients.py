@@ -8,6 +8,7 @@ import torch.nn.functional as F
 
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.texture import render_texture
+from radar_cli.sor.solid import Solid
 
 SIZE = 48
 N = 3
@@ -41,10 +42,10 @@ def autograd(loss_fn, params: list[torch.Tensor]) -> list[torch.Tensor]:
 def test_silhouette_loss_gradients_match_finite_differences(random_sor):
     radius, height, pose = random_sor(N, seed=3)
     tr, th, tp = random_sor(N, seed=4)
-    target = cast_rays(tr, th, tp, SIZE).sil.detach()
+    target = cast_rays(Solid(tr, th, tp), SIZE).sil.detach()
 
     def loss(r, h, p):
-        return ((cast_rays(r, h, p, SIZE).sil - target) ** 2).sum(dim=(1, 2))
+        return ((cast_rays(Solid(r, h, p), SIZE).sil - target) ** 2).sum(dim=(1, 2))
 
     params = [radius, height, pose]
     grads = autograd(loss, params)
@@ -69,7 +70,7 @@ def test_texture_render_loss_gradients_match_finite_differences(random_sor):
     weights = torch.rand(N, 3, SIZE, SIZE, generator=g, dtype=torch.float64)
 
     def loss(r, h, p, tex):
-        image, _ = render_texture(cast_rays(r, h, p, SIZE), tex)
+        image, _ = render_texture(cast_rays(Solid(r, h, p), SIZE), tex)
         return (image * weights).sum(dim=(1, 2, 3))
 
     params = [radius, height, pose, texture]

@@ -11,6 +11,7 @@ from radar_cli.render.raycast import cast_rays
 from radar_cli.sor.camera import pixel_rays, project
 from radar_cli.sor.mesh import triangulate
 from radar_cli.sor.pose import object_to_camera
+from radar_cli.sor.solid import Solid
 
 SIZE = 128
 N_SHAPES = 20
@@ -37,7 +38,7 @@ def reference_hits(radius, height, pose, camera):
 def test_silhouette_and_depth_match_trimesh(random_sor):
     camera = CameraConfig()
     radius, height, pose = random_sor(N_SHAPES, seed=1)
-    hits = cast_rays(radius, height, pose, SIZE, camera)
+    hits = cast_rays(Solid(radius, height, pose), SIZE, camera)
     ious, depth_errs = [], []
     for i in range(N_SHAPES):
         ref_mask, ref_depth = reference_hits(radius[i : i + 1], height[i : i + 1], pose[i : i + 1], camera)
@@ -56,8 +57,8 @@ def test_hits_only_search_leaves_every_hit_unchanged(random_sor):
     misses' margin search: every output on the object is the same as the full cast's (up to float32 rounding:
     vectorised and scalar exp differ in the last bit), and the soft silhouette is 0 off it."""
     radius, height, pose = random_sor(6, seed=3, dtype=torch.float32)
-    full = cast_rays(radius, height, pose, 96, CameraConfig(), 1.0)
-    hits_only = cast_rays(radius, height, pose, 96, CameraConfig(), 1.0, soft_outside=False)
+    full = cast_rays(Solid(radius, height, pose), 96, CameraConfig(), 1.0)
+    hits_only = cast_rays(Solid(radius, height, pose), 96, CameraConfig(), 1.0, soft_outside=False)
     on = full.mask
     assert torch.equal(hits_only.mask, on) and torch.equal(hits_only.inner, full.inner)
     for name in ("sil", "depth", "normal", "uv", "points"):

@@ -10,6 +10,8 @@ from radar_cli.config import RenderConfig
 from radar_cli.render import lighting
 from radar_cli.render.lighting import compose, decompose, env_directions, power, shading_factors, tone_map
 from radar_cli.render.scene import shade
+from radar_cli.sor.solid import Solid
+from radar_cli.render.material import Material
 
 HE, WE = 16, 48
 
@@ -29,7 +31,7 @@ def test_lambert_value_on_a_white_cylinder():
     height, pose = torch.tensor([0.8]), torch.zeros(1, 4)
     cfg = RenderConfig(shading_height=32, shading_width=32)
     albedo = torch.ones(1, 3, 32, 32)
-    shading = shade(radius, height, pose, albedo, env, torch.tensor([10.0]), torch.tensor([0.0]), cfg)
+    shading = shade(Solid(radius, height, pose), Material(albedo, env, torch.tensor([10.0]), torch.tensor([0.0])), cfg)
     # a cylinder at zero pose: normals are horizontal, n = (sin phi, 0, -cos phi)
     expected = value * w * (shading.normals[0].permute(1, 2, 0) @ light).clamp_min(0)  # Ht x Wt
     assert (shading.normals[0, 1].abs() < 1e-5).all()

@@ -11,6 +11,7 @@ from radar_cli.render.scene import render_front
 from radar_cli.render.texture import full_from_front, front_third, unwrap
 from radar_cli.sor.camera import project
 from radar_cli.sor.surface import surface_grid
+from radar_cli.sor.solid import Solid
 
 SIZE = 128
 TEX = (48, 48)
@@ -30,11 +31,11 @@ def test_unwrap_round_trip_over_the_visible_frontal_third(random_sor):
     camera = CameraConfig()
     radius, height, pose = random_sor(4, seed=21, dtype=torch.float32)
     texture = smooth_texture(4, seed=22)
-    hits = cast_rays(radius, height, pose, SIZE, camera)
+    hits = cast_rays(Solid(radius, height, pose), SIZE, camera)
     image, mask = render_front(hits, texture)
-    back = unwrap(radius, height, pose, image, TEX, camera)
+    back = unwrap(Solid(radius, height, pose), image, TEX, camera)
     # texels whose projection lies inside the rendered frontal mask (all four bilinear taps): the visible part
-    xy = project(surface_grid(radius, height, pose, *TEX, camera).points, camera)
+    xy = project(surface_grid(Solid(radius, height, pose), *TEX, camera).points, camera)
     visible = F.grid_sample(mask, xy, mode="bilinear", align_corners=False) > 0.999  # B x 1 x Ht x Wt
     assert visible.float().mean() > 0.8
     sel = visible.expand_as(texture)

@@ -9,6 +9,7 @@ import torch
 from radar_cli.config import CameraConfig
 from radar_cli.render.raycast import cast_rays
 from radar_cli.sor.outline import mask_outline, outline, vertical_extent
+from radar_cli.sor.solid import Solid
 
 SIZE = 192
 
@@ -23,8 +24,8 @@ def _vase(pitch: float, roll: float = 0.0, tx: float = 0.0, ty: float = 0.0):
                                   (22.0, -6.0, -0.1, 0.08)])
 def test_outline_matches_ray_cast_silhouette(pose):
     radius, height, p = _vase(*pose)
-    drawn = outline(radius, height, p, SIZE, CameraConfig())
-    cast = mask_outline(cast_rays(radius, height, p, SIZE, CameraConfig(), 1.0).mask[0].numpy())
+    drawn = outline(Solid(radius, height, p), SIZE, CameraConfig())
+    cast = mask_outline(cast_rays(Solid(radius, height, p), SIZE, CameraConfig(), 1.0).mask[0].numpy())
     for name in ("left", "right", "top", "bottom"):
         a, b = getattr(drawn, name)[0], getattr(cast, name)[0]
         # the same rows and columns are covered, but for one at either end that the outline grazes
@@ -38,7 +39,7 @@ def test_outline_is_differentiable_in_shape_and_pose():
     radius, height, pose = _vase(10.0)
     radius.requires_grad_(True)
     pose.requires_grad_(True)
-    drawn = outline(radius, height, pose, 64, CameraConfig())
+    drawn = outline(Solid(radius, height, pose), 64, CameraConfig())
     torch.nan_to_num(drawn.right - drawn.left).sum().backward()
     assert radius.grad.abs().sum() > 0 and pose.grad[0, 0] != 0
 
@@ -56,8 +57,8 @@ def test_mask_outline_sub_pixel():
 @pytest.mark.parametrize("pitch", [0.5, 12.0, 24.0])
 def test_vertical_extent_is_the_outlines_top_and_bottom(pitch):
     radius, height, pose = _vase(pitch, 3.0, 0.04, -0.03)
-    drawn = outline(radius, height, pose, SIZE, CameraConfig())
-    top, bottom = vertical_extent(radius, height, pose, SIZE, CameraConfig())
+    drawn = outline(Solid(radius, height, pose), SIZE, CameraConfig())
+    top, bottom = vertical_extent(Solid(radius, height, pose), SIZE, CameraConfig())
     assert float(top[0]) == pytest.approx(np.nanmin(drawn.top[0].numpy()), abs=1e-9)
     assert float(bottom[0]) == pytest.approx(np.nanmax(drawn.bottom[0].numpy()), abs=1e-9)
 
@@ -68,7 +69,7 @@ def test_outline_gradient_matches_finite_differences():
     weights = torch.randn(4, 2 * SIZE, generator=torch.Generator().manual_seed(0), dtype=torch.float64)
 
     def loss(t: torch.Tensor) -> torch.Tensor:
-        o = outline(t[None, :24], t[24:25], t[None, 25:], SIZE, CameraConfig())
+        o = outline(Solid(t[None, :24], t[24:25], t[None, 25:]), SIZE, CameraConfig())
         ends = torch.stack([torch.cat([o.left[0], o.right[0]]), torch.cat([o.top[0], o.bottom[0]]),
                             torch.cat([o.right[0], o.top[0]]), torch.cat([o.bottom[0], o.left[0]])])
         return (torch.nan_to_num(ends) * weights).sum()

@@ -16,6 +16,8 @@ from radar_cli.threads import torch_threads
 from radar_cli.model.config import LossConfig, ModelConfig, RunConfig, TrainConfig
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_view
+from radar_cli.sor.solid import Solid
+from radar_cli.render.material import Material
 
 
 def render_vases(root: Path, n: int, size: int, seed: int = 0) -> Path:
@@ -35,9 +37,10 @@ def render_vases(root: Path, n: int, size: int, seed: int = 0) -> Path:
         albedo[:, :, ::4] *= 0.5
         env = torch.full((1, 8, 24), 0.3)
         env[0, 2, 10] = 3.0
-        image, _ = render_view(radius, height, pose, albedo, env, torch.tensor([20.0]), torch.tensor([0.5]), size,
+        solid = Solid(radius, height, pose)
+        image, _ = render_view(solid, Material(albedo, env, torch.tensor([20.0]), torch.tensor([0.5])), size,
                                background=1.0)
-        hits = cast_rays(radius, height, pose, size)
+        hits = cast_rays(solid, size)
         write_sample(sample_ref(root, "train", f"v{k:03d}"), image[0].permute(1, 2, 0).clamp(0, 1).numpy(),
                      hits.mask[0].numpy())
     return root

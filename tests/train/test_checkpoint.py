@@ -34,7 +34,7 @@ def test_keep_last_k_and_round_trip(saved):
     image = torch.rand(2, 3, 32, 32)
     state.model.eval()
     with torch.no_grad():
-        for a, b in zip(model(image).as_tuple(), state.model(image).as_tuple()):
+        for a, b in zip(model(image).tensors(), state.model(image).tensors()):
             assert torch.equal(a, b)
 
 

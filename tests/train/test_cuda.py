@@ -73,5 +73,5 @@ def test_bundled_model_predicts_the_same_on_cuda():
     size = cpu.setup.image_size
     images = [rng.integers(0, 256, (size, size, 3), dtype=np.uint8) for _ in range(3)]
     a, b = cpu.predict(images), gpu.predict(images)
-    for x, y in zip(a.as_tuple(), b.as_tuple()):
+    for x, y in zip(a.tensors(), b.tensors()):
         assert torch.allclose(x, y, atol=1e-3, rtol=1e-3)

@@ -19,6 +19,7 @@ from radar_cli.synth.generator import SynthConfig, make_sample, write_sample_fol
 from radar_cli.model.weights import FORMAT, load_specular_reader, module_tensors
 from radar_cli.train.checkpoint import save_specular_reader
 from radar_cli.train.specular_reader import LAST_FILE, READER_FILE, ReaderConfig, train_reader
+from radar_cli.sor.solid import Solid
 
 from .conftest import tiny_config
 
@@ -57,8 +58,9 @@ def test_reader_starts_as_f_l_reading():
     image = torch.rand(2, 3, 32, 32)
     radius, height, pose = _shape()
     with torch.no_grad():
-        _, _, rho = model.light_net(*model.unwrap_inputs(radius, height, pose, image))
-        read = reader(image, radius, height, pose)
+        solid = Solid(radius, height, pose)
+        _, _, rho = model.light_net(*model.unwrap_inputs(solid, image))
+        read = reader(image, solid)
     assert torch.allclose(read * 2, rho, atol=1e-6)  # f_L reads 0..2, the reader 0..1
 
 
@@ -88,9 +90,9 @@ def test_reader_files_round_trip_and_foreign_files_are_refused(base, tmp_path):
     reader = SpecularReader(tiny_config().model).eval()
     path = save_specular_reader(reader, tmp_path / "r.safetensors")
     loaded = load_specular_reader(path)
-    image, shape = torch.rand(2, 3, 32, 32), _shape()
+    image, solid = torch.rand(2, 3, 32, 32), Solid(*_shape())
     with torch.no_grad():
-        assert torch.equal(loaded(image, *shape), reader(image, *shape))
+        assert torch.equal(loaded(image, solid), reader(image, solid))
     with pytest.raises(CheckpointError, match="not a radar specular-albedo reader"):
         load_specular_reader(base)
     broken = tmp_path / "broken.safetensors"

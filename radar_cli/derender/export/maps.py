@@ -65,12 +65,12 @@ def write_maps(folder: Path, state: ObjectState, tex_render) -> None:
         tex_render: RenderConfig of the network (its shading grid is used for the frontal maps).
     """
     gamma = state.render.gamma
-    write_picture(folder / ALBEDO_FILE, chw_image(tone_map(state.albedo, gamma)))
-    front = front_third(state.albedo)  # 1 x 3 x Ht x Wt
-    s = shade(state.radius, state.height, state.pose, front, state.env, state.alpha, state.rho, tex_render,
+    write_picture(folder / ALBEDO_FILE, chw_image(tone_map(state.material.albedo, gamma)))
+    front = front_third(state.material.albedo)  # 1 x 3 x Ht x Wt
+    s = shade(state.solid, state.material.with_albedo(front), tex_render,
               state.camera)
     write_picture(folder / TEXTURE_FILE, chw_image(s.texture))
     write_picture(folder / NORMAL_FILE, chw_image((s.normals + 1) / 2))
     write_picture(folder / DIFFUSE_FILE, chw_image(tone_map(s.diffuse, gamma)))
-    write_picture(folder / SPECULAR_FILE, chw_image(tone_map(state.rho[:, None, None, None] * s.specular, gamma)))
-    write_env(folder, state.env[0].numpy(), gamma)
+    write_picture(folder / SPECULAR_FILE, chw_image(tone_map(state.material.rho[:, None, None, None] * s.specular, gamma)))
+    write_env(folder, state.material.env[0].numpy(), gamma)

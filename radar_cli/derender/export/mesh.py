@@ -29,11 +29,11 @@ def build_mesh(state: ObjectState, n_cols: int) -> trimesh.Trimesh:
         state: the object.
         n_cols: K, angles around the axis.
     """
-    sor = triangulate(state.radius, state.height, n_cols, closed_bottom=True, camera=state.camera)
-    texture = Image.fromarray(chw_image(tone_map(state.albedo, state.render.gamma)))
+    sor = triangulate(state.solid.radius, state.solid.height, n_cols, closed_bottom=True, camera=state.camera)
+    texture = Image.fromarray(chw_image(tone_map(state.material.albedo, state.render.gamma)))
     material = trimesh.visual.material.PBRMaterial(
         name="albedo", baseColorTexture=texture, metallicFactor=0.0,
-        roughnessFactor=roughness_from_shininess(float(state.alpha[0])), doubleSided=True)
+        roughnessFactor=roughness_from_shininess(float(state.material.alpha[0])), doubleSided=True)
     visual = trimesh.visual.TextureVisuals(uv=sor.uv.numpy(), material=material)
     vertices = sor.vertices.numpy().astype(np.float64) * TO_VIEWER_FRONT
     return trimesh.Trimesh(vertices, sor.faces.numpy(), visual=visual, process=False)
@@ -45,10 +45,10 @@ def write_meshes(folder: Path, state: ObjectState, n_cols: int) -> None:
     write_bytes(folder / MESH_GLB_FILE, mesh.export(file_type="glb"))
     obj_mesh = mesh.copy()
     # OBJ/MTL is Phong: white Kd so viewers show the texture as is, Ns = shininess, Ks from the specular albedo
-    spec = int(round(255 * min(float(state.rho[0]) / 2.0, MAX_SPECULAR_FACTOR)))
+    spec = int(round(255 * min(float(state.material.rho[0]) / 2.0, MAX_SPECULAR_FACTOR)))
     obj_mesh.visual.material = trimesh.visual.material.SimpleMaterial(
         name="albedo", image=mesh.visual.material.baseColorTexture, diffuse=(255, 255, 255, 255),
-        ambient=(255, 255, 255, 255), specular=(spec, spec, spec, 255), glossiness=float(state.alpha[0]))
+        ambient=(255, 255, 255, 255), specular=(spec, spec, spec, 255), glossiness=float(state.material.alpha[0]))
     text, files = trimesh.exchange.obj.export_obj(obj_mesh, include_texture=True, return_texture=True,
                                                   mtl_name="mesh.mtl")
     for name, data in files.items():

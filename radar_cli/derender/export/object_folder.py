@@ -74,7 +74,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
     write_maps(folder, state, setup.render)
     write_meshes(folder, state, setup.geometry.n_cols)
     drawn, recon = write_renders(folder, state, side, config.view_side(side), config.views, envs)
-    record = state.material()
+    record = state.record()
     record.update({
         "source": str(item.image_path),
         "crop_box": prepared.crop.to_list(),

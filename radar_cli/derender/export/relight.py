@@ -37,9 +37,9 @@ def relight(folder: str | Path, env_path: str | Path, out: str | Path, yaw_deg: 
     size = size or int(record.get("resolution", record.get("image_size", 256)))
     if not 8 <= size <= MAX_SIZE:
         raise InputError(f"--size must lie in [8, {MAX_SIZE}], got {size}")
-    env = load_environment(env_path, state.env.shape[1], state.env.shape[2])
+    env = load_environment(env_path, state.material.env.shape[1], state.material.env.shape[2])
     if match:
-        env = match_exposure(env, state.env[0].numpy())
+        env = match_exposure(env, state.material.env[0].numpy())
     image = render_object(state, size, yaw_deg, pitch_deg, env=torch.from_numpy(env)[None])
     write_image(out, image)
     return Path(out)

@@ -25,6 +25,8 @@ from radar_cli.sor.surface import FULL_SPAN
 from radar_cli.results import (ALBEDO_RENDERED_FILE, DIFFUSE_RENDERED_FILE, MASK_FILE, MASK_FRONT_FILE,
                                MATERIAL_SPHERE_FILE, NORMAL_RENDERED_FILE, RECON_FILE, RELIT_PREFIX,
                                SPECULAR_RENDERED_FILE, TURNTABLE_GIF_FILE, TURNTABLE_STRIP_FILE)
+from radar_cli.sor.solid import Solid
+from radar_cli.render.material import Material
 
 SPHERE_ROWS = 64
 SPHERE_RADIUS = 0.8  # fraction of r_max
@@ -48,12 +50,13 @@ class ViewRenderer:
 
     def __init__(self, state: ObjectState, size: int, pitch_deg: float | None = None, hits: Hits | None = None):
         self.state = state
-        self.pose = state.pose.clone()
+        pose = state.solid.pose.clone()
         if pitch_deg is not None:
-            self.pose[:, 0] = pitch_deg
+            pose[:, 0] = pitch_deg
+        self.solid = Solid(state.solid.radius, state.solid.height, pose)
         if hits is None:
             with torch.no_grad():
-                hits = cast_rays(state.radius, state.height, self.pose, size, state.camera,
+                hits = cast_rays(self.solid, size, state.camera,
                                  state.render.sil_sigma_px)
         self.hits = hits
 
@@ -61,16 +64,15 @@ class ViewRenderer:
     def shading(self, env: torch.Tensor | None = None) -> Shading:
         """The 360 deg lighting factors under `env` (1 x He x We; default: the predicted one)."""
         s = self.state
-        env = s.env if env is None else env
-        return shade(s.radius, s.height, self.pose, s.albedo, env, s.alpha, s.rho, s.render, s.camera,
-                     span=FULL_SPAN)
+        material = s.material if env is None else Material(s.material.albedo, env, s.material.alpha, s.material.rho)
+        return shade(self.solid, material, s.render, s.camera, span=FULL_SPAN)
 
     @torch.no_grad()
     def draw(self, shading: Shading, yaw_deg: float = 0.0, background: float = 1.0) -> np.ndarray:
         """The shaded object spun by `yaw_deg`: size x size x 3 uint8 over a grey level `background`."""
         s = self.state
-        albedo = rotate_full_map(s.albedo, yaw_deg)
-        texture = compose(albedo, shading.diffuse, shading.specular, s.rho, s.render.gamma)
+        albedo = rotate_full_map(s.material.albedo, yaw_deg)
+        texture = compose(albedo, shading.diffuse, shading.specular, s.material.rho, s.render.gamma)
         image, _ = render_texture(self.hits, texture, front_only=False, inside_dim=s.render.inside_dim,
                                   background=background)
         return chw_image(image)
@@ -99,17 +101,17 @@ def write_input_view(folder: Path, state: ObjectState, size: int) -> tuple[ViewR
     hits = view.hits
     coverage = torch.where(hits.mask, torch.ones_like(hits.sil), hits.sil)  # 1 x S x S
     write_picture(folder / MASK_FILE, to_uint8(coverage[0].numpy()))
-    _, front = render_front(hits, torch.ones_like(state.albedo[:, :1, :, : state.albedo.shape[-1] // 3]))
+    _, front = render_front(hits, torch.ones_like(state.material.albedo[:, :1, :, : state.material.albedo.shape[-1] // 3]))
     write_picture(folder / MASK_FRONT_FILE, to_uint8(front[0, 0].numpy()))
     # drawn as radar synth draws its ground truth (black off the hard silhouette), so radar eval compares like
     # with like at the outline
-    write_picture(folder / ALBEDO_RENDERED_FILE, _on_object(hits, tone_map(state.albedo, state.render.gamma)))
+    write_picture(folder / ALBEDO_RENDERED_FILE, _on_object(hits, tone_map(state.material.albedo, state.render.gamma)))
     normals = torch.where(hits.mask[..., None], (hits.normal + 1) / 2, torch.zeros_like(hits.normal))
     write_picture(folder / NORMAL_RENDERED_FILE, to_uint8(normals[0].numpy()))
     shading = view.shading()
     recon = view.draw(shading)
     write_picture(folder / RECON_FILE, recon)
-    gamma, rho = state.render.gamma, state.rho[:, None, None, None]
+    gamma, rho = state.render.gamma, state.material.rho[:, None, None, None]
     write_picture(folder / DIFFUSE_RENDERED_FILE, _on_object(hits, tone_map(shading.diffuse, gamma)))
     write_picture(folder / SPECULAR_RENDERED_FILE, _on_object(hits, tone_map(rho * shading.specular, gamma)))
     return view, recon
@@ -134,15 +136,15 @@ def _sphere_hits(size: int, camera: CameraConfig, sigma_px: float) -> Hits:
     """The sphere's ray casting is the same for every object: done once per size."""
     radius, height = sphere_profile()
     with torch.no_grad():
-        return cast_rays(radius, height, torch.zeros(1, 4), size, camera, sigma_px)
+        return cast_rays(Solid(radius, height, torch.zeros(1, 4)), size, camera, sigma_px)
 
 
 def material_sphere(state: ObjectState, size: int) -> np.ndarray:
     """The recovered material and lighting on a sphere with the object's mean albedo, seen straight on."""
     radius, height = sphere_profile()
-    mean = state.albedo.mean(dim=(2, 3), keepdim=True)  # 1 x 3 x 1 x 1
-    sphere = dataclasses.replace(state, radius=radius, height=height, pose=torch.zeros(1, 4),
-                                 albedo=mean.expand(-1, -1, 16, 48).contiguous())
+    mean = state.material.albedo.mean(dim=(2, 3), keepdim=True)  # 1 x 3 x 1 x 1
+    sphere = dataclasses.replace(state, solid=Solid(radius, height, torch.zeros(1, 4)),
+                                 material=state.material.with_albedo(mean.expand(-1, -1, 16, 48).contiguous()))
     view = ViewRenderer(sphere, size, hits=_sphere_hits(size, state.camera, state.render.sil_sigma_px))
     return view.draw(view.shading())
 
@@ -172,11 +174,11 @@ def write_turntable(folder: Path, view: ViewRenderer, frames: int) -> None:
 def texture_for_size(state: ObjectState, size: int) -> ObjectState:
     """The object with its albedo averaged down to about one texel per pixel of a size x size view (the full
     map is 3x wider): small views then shade and sample a texture of their own scale."""
-    rows = state.albedo.shape[2]
+    rows = state.material.albedo.shape[2]
     if rows <= size:
         return state
-    albedo = F.interpolate(state.albedo, size=(size, 3 * size), mode="area")  # 1 x 3 x S x 3S
-    return dataclasses.replace(state, albedo=albedo)
+    albedo = F.interpolate(state.material.albedo, size=(size, 3 * size), mode="area")  # 1 x 3 x S x 3S
+    return dataclasses.replace(state, material=state.material.with_albedo(albedo))
 
 
 def relit_file(name: str) -> str:
@@ -187,7 +189,7 @@ def relit_file(name: str) -> str:
 def write_relit(folder: Path, view: ViewRenderer, envs: dict[str, np.ndarray]) -> None:
     """relit_<name>.png for every environment (He x We maps, camera frame), from the input's view, each at the
     exposure of the object's own lighting."""
-    own = view.state.env[0].numpy()
+    own = view.state.material.env[0].numpy()
     for name, env in envs.items():
         shading = view.shading(torch.from_numpy(match_exposure(np.asarray(env, np.float32), own))[None])
         write_picture(folder / relit_file(name), view.draw(shading))

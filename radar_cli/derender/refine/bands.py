@@ -20,6 +20,7 @@ import torch
 from radar_cli.config import CameraConfig
 from radar_cli.render.texture import sample_surface
 from radar_cli.sor.surface import surface_grid
+from radar_cli.sor.solid import Solid
 
 
 @dataclass(frozen=True)
@@ -64,7 +65,7 @@ def band_coherence(detail: np.ndarray, inner: np.ndarray, radius: torch.Tensor, 
         every candidate count, so the candidates are scored on the same part of the surface.
     """
     image = torch.from_numpy(np.stack([detail, inner])).to(radius.dtype)[None]  # 1 x 2 x N x N
-    grid = surface_grid(radius, height, pose, cue.rows, cue.cols, camera)
+    grid = surface_grid(Solid(radius, height, pose), cue.rows, cue.cols, camera)
     tex = sample_surface(image, grid, camera)  # B x 2 x R x C, one image shared by every candidate
     facing = (grid.normals * grid.view).sum(-1)  # B x R x C
     usable = (tex[:, 1] > 0.999) & (facing > cue.min_facing)

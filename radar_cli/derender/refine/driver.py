@@ -25,6 +25,7 @@ from radar_cli.model.specular_reader import SpecularReader
 from radar_cli.render.raycast import cast_rays
 from radar_cli.sor.outline import mask_outline, outline
 from radar_cli.threads import torch_threads
+from radar_cli.sor.solid import Solid
 
 RefineMode = Literal["full", "shape", "none"]
 REFINE_MODES: tuple[RefineMode, ...] = ("full", "shape", "none")
@@ -83,7 +84,7 @@ def silhouette_iou(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tenso
                    camera: CameraConfig) -> float:
     """IoU of the ray-cast silhouette (N x N, hard) with an N x N bool mask."""
     with torch.no_grad():
-        drawn = cast_rays(radius.float(), height.float(), pose.float(), mask.shape[0], camera, 1.0,
+        drawn = cast_rays(Solid(radius.float(), height.float(), pose.float()), mask.shape[0], camera, 1.0,
                           soft_outside=False).mask[0].numpy()
     return iou(drawn, mask)
 
@@ -112,7 +113,7 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
     start = time.perf_counter()
     network_iou = silhouette_iou(dec.radius, dec.height, dec.pose, silhouette, camera)
     target = mask_outline(silhouette)
-    network_px = float(outline_score(outline(dec.radius, dec.height, dec.pose, size, camera), target,
+    network_px = float(outline_score(outline(dec.solid, size, camera), target,
                                      absolute=True)[0])
     grey = crop.astype(np.float32).mean(axis=2) / 255.0
     try:
@@ -131,9 +132,9 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
                                                f"against the network's {network_iou:.3f})")
     device = image.device
     with torch.no_grad():
-        geo = (fit.radius.to(device), fit.height.to(device), fit.pose.to(device))
-        refined = model.read_appearance(image, *geo).detach()
-        rho = refined.rho.clamp(max=MAX_SPECULAR_ALBEDO) if reader is None else reader(image, *geo)
+        solid = Solid(fit.radius, fit.height, fit.pose).map(lambda t: t.to(device))
+        refined = model.read_appearance(image, solid).detach()
+        rho = refined.rho.clamp(max=MAX_SPECULAR_ALBEDO) if reader is None else reader(image, solid)
     refined = dataclasses.replace(refined, rho=rho)
     report = dataclasses.replace(report, specular="network" if reader is None else "reader")
     if light is not None:

@@ -37,6 +37,7 @@ from radar_cli.render.lighting import GAMMA, decompose, env_directions, phong_tr
 from radar_cli.render.texture import sample_surface
 from radar_cli.sor.surface import surface_grid
 from radar_cli.threads import torch_threads
+from radar_cli.sor.solid import Solid
 
 
 @dataclass(frozen=True)
@@ -161,7 +162,7 @@ class _Texels:
         return float(((drawn - self.shown) ** 2).mean().sqrt())
 
 
-def _texels(crop: np.ndarray, silhouette: np.ndarray, geo: tuple[torch.Tensor, ...], start: torch.Tensor,
+def _texels(crop: np.ndarray, silhouette: np.ndarray, geo: Solid, start: torch.Tensor,
             alpha: float, rho: float, camera: CameraConfig, config: LightFitConfig) -> _Texels | None:
     """Unwrap the crop at the shape, keep the usable texels and cluster them into paints under `start`
     (He x We float64); None when under 5% of the grid is usable."""
@@ -169,7 +170,7 @@ def _texels(crop: np.ndarray, silhouette: np.ndarray, geo: tuple[torch.Tensor, .
     dtype = torch.float64
     image = torch.from_numpy(np.ascontiguousarray(crop)).permute(2, 0, 1)[None].to(dtype) / 255.0
     cover = torch.from_numpy(silhouette.astype(np.float64))[None, None]
-    grid = surface_grid(*geo, g, g, camera)
+    grid = surface_grid(geo, g, g, camera)
     texture = sample_surface(torch.cat([image, cover], 1), grid, camera)[0].reshape(4, -1)  # 4 x g*g
     normals, view = grid.normals[0].reshape(-1, 3), grid.view[0].reshape(-1, 3)
     usable = (texture[3] > config.coverage) & ((normals * view).sum(-1) > config.min_facing)
@@ -231,7 +232,7 @@ def fit_environment(crop: np.ndarray, silhouette: np.ndarray, radius: torch.Tens
 def _fit(crop: np.ndarray, silhouette: np.ndarray, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
          env: torch.Tensor, alpha: float, rho: float, camera: CameraConfig, config: LightFitConfig) -> LightFit | None:
     """fit_environment's work, on the calling thread's torch threads."""
-    geo = (radius.double().cpu(), height.double().cpu(), pose.double().cpu())
+    geo = Solid(radius, height, pose).map(lambda t: t.double().cpu())
     start = env[0].double().cpu()
     texels = _texels(crop, silhouette, geo, start, alpha, rho, camera, config)
     if texels is None:

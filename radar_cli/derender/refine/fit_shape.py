@@ -25,6 +25,7 @@ from radar_cli.config import CameraConfig
 from radar_cli.derender.refine.bands import BandCue, band_coherence, high_pass
 from radar_cli.sor.outline import Outline, disc_conics, mask_outline, outline, roots, vertical_extent
 from radar_cli.sor.pose import rotation_matrix, translation
+from radar_cli.sor.solid import Solid
 
 
 @dataclass(frozen=True)
@@ -184,7 +185,7 @@ def closed_form(target: Outline, size: int, pitches: torch.Tensor, roll: float, 
     unit = 2.0 / size  # r_max fractions per pixel at the object's distance
     for _ in range(config.placement_iterations):
         radius = profile_from_widths(target, height, pose, config.rows, size, camera)
-        drawn_top, drawn_bottom = vertical_extent(radius, height, pose, size, camera)
+        drawn_top, drawn_bottom = vertical_extent(Solid(radius, height, pose), size, camera)
         d_top, d_bottom = top - drawn_top, bottom - drawn_bottom
         height = (height + (d_bottom - d_top) / 2 * unit / torch.cos(torch.deg2rad(pose[:, 0]))).clamp(0.3, 1.2)
         pose[:, 3] = pose[:, 3] - (d_top + d_bottom) / 2 * unit
@@ -204,7 +205,7 @@ def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor,
         B contrasts (0 where the rim's ellipse has no width, i.e. seen edge on, or where less than half of the
         arc's samples lie on the object).
     """
-    q = disc_conics(radius, height, pose, 2, camera)[:, 0]  # B x 3 x 3, the top disc
+    q = disc_conics(Solid(radius, height, pose), 2, camera)[:, 0]  # B x 3 x 3, the top disc
     x = torch.linspace(-1, 1, samples, dtype=torch.float64)
     # the rim's front arc: per column, the lower root y of the top disc's conic (y up)
     front, _ = roots(q[:, 1, 1, None].expand(-1, samples), q[:, 0, 1, None] * x + q[:, 1, 2, None],
@@ -228,7 +229,7 @@ def _search(target: Outline, grey: torch.Tensor, size: int, pitches: torch.Tenso
             config: ShapeFitConfig, camera: CameraConfig, lip_offset_px: float):
     """Score a grid of candidate pitches: (shapes, outline + bending scores B, lip contrasts B)."""
     radius, height, pose = closed_form(target, size, pitches, roll, tx, config, camera)
-    score = outline_score(outline(radius, height, pose, size, camera), target)
+    score = outline_score(outline(Solid(radius, height, pose), size, camera), target)
     score = score + config.roughness_weight * roughness(radius)
     return (radius, height, pose), score, lip_contrast(grey, radius, height, pose, lip_offset_px, camera)
 
@@ -302,7 +303,8 @@ def polish(target: Outline, size: int, radius: torch.Tensor, height: torch.Tenso
     for _ in range(steps):
         opt.zero_grad()
         r, h, p = unpack(x)
-        loss = (outline_score(outline(r, h, p, size, camera), target) + config.roughness_weight * roughness(r)).sum()
+        drawn = outline(Solid(r, h, p), size, camera)
+        loss = (outline_score(drawn, target) + config.roughness_weight * roughness(r)).sum()
         loss.backward()
         opt.step()
     return unpack(x.detach())
@@ -332,7 +334,7 @@ def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = Shape
     for level, steps in zip((grid, size), config.polish_steps):
         level_target = coarse_target if level == grid else target
         radius, height, pose = polish(level_target, level, radius, height, pose, steps, config, camera)
-    error = float(outline_score(outline(radius, height, pose, size, camera), target, absolute=True)[0])
+    error = float(outline_score(outline(Solid(radius, height, pose), size, camera), target, absolute=True)[0])
     return ShapeFit(radius.float(), height.float(), pose.float(), error, cue)
 
 
@@ -344,7 +346,7 @@ def correct_widths(target: Outline, size: int, radius: torch.Tensor, height: tor
     target_width = (target.right - target.left)[0].numpy()
     tan = _tan(camera)
     for _ in range(rounds):
-        drawn = outline(radius, height, pose, size, camera)
+        drawn = outline(Solid(radius, height, pose), size, camera)
         width = (drawn.right - drawn.left).numpy()  # B x S
         centre = _disc_centres(height, pose, radius.shape[1], camera)
         row = ((1 - centre[..., 1] / centre[..., 2] / tan) * size / 2 - 0.5).numpy()

@@ -20,6 +20,7 @@ from radar_cli.model.outputs import Decomposition
 from radar_cli.model.radar import RadarModel
 from radar_cli.render.lighting import compose
 from radar_cli.render.scene import render_front, render_frontal
+from radar_cli.sor.solid import Solid
 
 
 @dataclass(frozen=True)
@@ -63,8 +64,8 @@ def score(model: RadarModel, image: torch.Tensor, mask: torch.Tensor, dt: torch.
     c = model.config
     pose = first.pose.clone()
     pose[:, 0] = pitch
-    pred = model.read_appearance(image, first.radius, first.height, pose)
-    hits, shading, recon, front = render_frontal(*pred.as_tuple(), c.render, c.camera)
+    pred = model.read_appearance(image, Solid(first.radius, first.height, pose))
+    hits, shading, recon, front = render_frontal(pred.solid, pred.material, c.render, c.camera)
     tex_mu = compose(L.mean_color(pred.albedo), shading.diffuse, shading.specular, pred.rho, c.render.gamma)
     recon_mu, _ = render_front(hits, tex_mu)
     weight = mask[:, None] * front  # B x 1 x H x W
@@ -89,10 +90,10 @@ def _grid_scores(model: RadarModel, image: torch.Tensor, mask: torch.Tensor, dt:
     for start in range(0, batch, per_call):
         part = slice(start, start + per_call)
         # each of the chunk's n samples repeated G times, candidate-minor: (n * G) x ...
-        image_g, mask_g, dt_g, *first_g = (t[part].repeat_interleave(grid, dim=0)
-                                           for t in (image, mask, dt, *first.as_tuple()))
+        image_g, mask_g, dt_g = (t[part].repeat_interleave(grid, dim=0) for t in (image, mask, dt))
+        first_g = first.map(lambda t: t[part].repeat_interleave(grid, dim=0))
         pitch = candidates[part].clamp(lo, hi).reshape(-1)  # (n * G)
-        scores = score(model, image_g, mask_g, dt_g, Decomposition(*first_g), pitch, search)
+        scores = score(model, image_g, mask_g, dt_g, first_g, pitch, search)
         chunks.append(scores.view(-1, grid))
     return torch.cat(chunks)
 
@@ -133,4 +134,4 @@ def search_pitch(model: RadarModel, image: torch.Tensor, masks: list[np.ndarray]
     pitch = (best + parabola_vertex(scores, search.fine_step)).clamp(lo, hi)
     pose = first.pose.clone()
     pose[:, 0] = pitch
-    return model.read_appearance(image, first.radius, first.height, pose)
+    return model.read_appearance(image, Solid(first.radius, first.height, pose))

@@ -170,8 +170,8 @@ class Predictor:
             dec = self._search_pitch(batch, silhouettes, dec)
         if self.albedo == "divided":
             render, camera = self.setup.render, self.setup.camera
-            shading = shade(*dec.as_tuple(), render, camera)
-            albedo = divide_shading(batch, dec.radius, dec.height, dec.pose, dec.albedo, dec.rho, shading, render,
+            shading = shade(dec.solid, dec.material, render, camera)
+            albedo = divide_shading(batch, dec.solid, dec.albedo, dec.rho, shading, render,
                                     camera, coverage)
             dec = dataclasses.replace(dec, albedo=albedo)
         return dec.detach().to("cpu")
@@ -204,9 +204,9 @@ class Predictor:
         if not known:
             return dec
         index = torch.tensor(known, device=self.device)
-        part = Decomposition(*(t.index_select(0, index) for t in dec.as_tuple()))
+        part = dec.map(lambda t: t.index_select(0, index))
         found = search_pitch(self.model, batch.index_select(0, index), [silhouettes[i] for i in known], part)
-        return Decomposition(*(t.index_copy(0, index, f) for t, f in zip(dec.as_tuple(), found.as_tuple())))
+        return dec.combine(found, lambda t, f: t.index_copy(0, index, f))
 
 
 def _coverage(silhouettes: list[np.ndarray | None], size: int) -> torch.Tensor:

@@ -17,8 +17,10 @@ from radar_cli.errors import InputError
 from radar_cli.fileio import read_image, to_uint8
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.lighting import tone_map
+from radar_cli.render.material import Material
 from radar_cli.render.texture import full_from_front
 from radar_cli.results import ALBEDO_FILE, ENV_MAP_FILE, MATERIAL_FILE
+from radar_cli.sor.solid import Solid
 
 EXPORT_SHADING_GRID = 32  # at most this many rows and columns (per frontal third) in whole-object renders' shading
 
@@ -44,20 +46,14 @@ class ObjectState:
     """One object, batch of one.
 
     Attributes:
-        radius: 1 x L; height: 1; pose: 1 x 4 (pitch deg, roll deg, tx, ty).
-        albedo: 1 x 3 x Ht x 3Wt linear 360 deg albedo (back mirrored from the front), 8-bit exact.
-        env: 1 x He x We linear environment map, camera frame.
-        alpha: 1 shininess; rho: 1 specular albedo.
+        solid: the shape and pose (radius 1 x L; height 1; pose 1 x 4 pitch deg, roll deg, tx, ty).
+        material: albedo 1 x 3 x Ht x 3Wt the linear 360 deg map (back mirrored from the front), 8-bit exact;
+            env 1 x He x We linear, camera frame; alpha 1 shininess; rho 1 specular albedo.
         render: the renderer settings of whole-object renders; camera: the fixed camera.
     """
 
-    radius: torch.Tensor
-    height: torch.Tensor
-    pose: torch.Tensor
-    albedo: torch.Tensor
-    env: torch.Tensor
-    alpha: torch.Tensor
-    rho: torch.Tensor
+    solid: Solid
+    material: Material
     render: RenderConfig
     camera: CameraConfig
 
@@ -69,15 +65,16 @@ class ObjectState:
         export_render = dataclasses.replace(render, shading_height=min(render.shading_height, EXPORT_SHADING_GRID),
                                             shading_width=min(render.shading_width, EXPORT_SHADING_GRID))
         albedo = quantise(full_from_front(dec.albedo.float().clamp(0, 1)), render.gamma)
-        return cls(dec.radius.float(), dec.height.float(), dec.pose.float(), albedo, dec.env.float(),
-                   dec.alpha.float(), dec.rho.float(), export_render, camera)
+        material = dec.material.map(torch.Tensor.float).with_albedo(albedo)
+        return cls(dec.solid.map(torch.Tensor.float), material, export_render, camera)
 
-    def material(self) -> dict:
+    def record(self) -> dict:
         """The material.json record of the shape, pose, material and renderer settings."""
-        pitch, roll, tx, ty = (float(v) for v in self.pose[0])
-        alpha = float(self.alpha[0])
-        return {"pitch": pitch, "roll": roll, "tx": tx, "ty": ty, "height": float(self.height[0]),
-                "radius": [float(r) for r in self.radius[0]], "alpha": alpha, "rho": float(self.rho[0]),
+        pitch, roll, tx, ty = (float(v) for v in self.solid.pose[0])
+        alpha = float(self.material.alpha[0])
+        return {"pitch": pitch, "roll": roll, "tx": tx, "ty": ty, "height": float(self.solid.height[0]),
+                "radius": [float(r) for r in self.solid.radius[0]], "alpha": alpha,
+                "rho": float(self.material.rho[0]),
                 "roughness": roughness_from_shininess(alpha), "render": to_dict(self.render),
                 "camera": to_dict(self.camera)}
 
@@ -118,4 +115,5 @@ def read_state(folder: str | Path) -> ObjectState:
         raise InputError(f"{folder / ENV_MAP_FILE}: not a readable environment map ({e})") from None
     if env.ndim != 2:
         raise InputError(f"{folder / ENV_MAP_FILE}: expected He x We, got shape {env.shape}")
-    return ObjectState(radius, height, pose, albedo, torch.from_numpy(env)[None], alpha, rho, render, camera)
+    return ObjectState(Solid(radius, height, pose), Material(albedo, torch.from_numpy(env)[None], alpha, rho), render,
+                       camera)

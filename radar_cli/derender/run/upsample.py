@@ -15,6 +15,8 @@ from radar_cli.derender.run.state import ObjectState
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.scene import divide_shading, shade
 from radar_cli.sor.resample import smooth_rows
+from radar_cli.sor.solid import Solid
+from radar_cli.render.material import Material
 
 PROFILE_ROWS = 128
 """Rows of the exported profile away from the network's side (the meshes' rings; the renderer interpolates
@@ -71,8 +73,8 @@ def full_resolution_state(dec: Decomposition, prepared: Prepared, setup: ModelSe
         render = dataclasses.replace(setup.render, tex_height=side, tex_width=side)
         height, pose, env = dec.height.float(), dec.pose.float(), dec.env.float()
         alpha, rho = dec.alpha.float(), dec.rho.float()
-        shading = shade(radius, height, pose, front, env, alpha, rho, render, setup.camera)
+        shading = shade(Solid(radius, height, pose), Material(front, env, alpha, rho), render, setup.camera)
         image, coverage = photo_tensors(prepared)
-        front = divide_shading(image, radius, height, pose, front, rho, shading, render, setup.camera, coverage)
+        front = divide_shading(image, Solid(radius, height, pose), front, rho, shading, render, setup.camera, coverage)
     return ObjectState.from_decomposition(dataclasses.replace(dec, radius=radius, albedo=front), setup.render,
                                           setup.camera)
