@@ -105,7 +105,8 @@ def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks
     summary = derender_sharded(list(inputs), load, options, device, say=lambda line: click.echo(line, err=True))
     if contact_sheet is not None and summary.index is not None and (summary.done or summary.skipped):
         click.echo(f"contact sheet: {write_contact_sheet(out, contact_sheet)}")
-    click.echo(summary.line())
+    if summary.printed:
+        click.echo(summary.line())
     if summary.index is not None:
         click.echo(f"gallery: {summary.index}")
     if summary.failures:
