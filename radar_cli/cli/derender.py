@@ -76,7 +76,8 @@ RESOLUTION = ResolutionType()
                    f"[default: the output side, at least {MIN_VIEW_SIZE}].")
 @click.option("--env", "envs", multiple=True, type=click.Path(dir_okay=False, path_type=Path),
               help="Extra relighting environment map (.hdr, .exr, .png, .npy); repeatable.")
-@click.option("--batch-size", type=click.IntRange(1, 1024), default=8, show_default=True)
+@click.option("--batch-size", type=click.IntRange(1, 1024), default=8, show_default=True,
+              help="Images per network batch.")
 @click.option("--workers", type=click.IntRange(0, 64), default=2, show_default=True,
               help="Threads reading and cropping images, and exporting objects.")
 @click.option("--threads", type=click.IntRange(1, 256), default=1, show_default=True,

@@ -19,15 +19,24 @@ from radar_cli.train.trainer import build_state, train_step
 
 
 def elliptic_batch(config: RunConfig, batch_size: int, device: torch.device) -> Batch:
-    """Random B x 3 x S x S images with one elliptic B x S x S mask (and its distance transform): the work of a
-    training step without a dataset."""
+    """Random B x 3 x S x S images with one elliptic B x S x S mask (and its distance transform), and B pitch
+    labels of 10 deg when the preset self-trains on pitch: the work of a training step without a dataset."""
     size = config.model.render.image_size
     c = (torch.arange(size) + 0.5) / size * 2 - 1
     yy, xx = torch.meshgrid(c, c, indexing="ij")
     mask = ((xx / 0.45) ** 2 + (yy / 0.8) ** 2 < 1).float().expand(batch_size, size, size).contiguous()
     dt = torch.from_numpy(distance_transform(mask[0].numpy() > 0)).expand_as(mask).contiguous()
     image = torch.rand(batch_size, 3, size, size, generator=torch.Generator().manual_seed(0))
-    return Batch(image.to(device), mask.to(device), dt.to(device))
+    labels = torch.full((batch_size,), 10.0, device=device) if config.loss.pitch_label_weight > 0 else None
+    return Batch(image.to(device), mask.to(device), dt.to(device), pitch_label=labels)
+
+
+def bundled_config() -> RunConfig:
+    """The training configuration stored in the bundled model (the default preset of `radar bench train`)."""
+    from radar_cli.derender.predictor import bundled_checkpoint
+    from radar_cli.train.checkpoint import read_checkpoint
+
+    return read_checkpoint(bundled_checkpoint())[2]
 
 
 def bench_train(config: RunConfig | str | Path, steps: int = 5, warmup: int = 2, batch_size: int | None = None,
