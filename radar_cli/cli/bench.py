@@ -37,8 +37,8 @@ def render(device: str, sizes: str, batch: int, repeats: int, threads: int) -> N
 
 @bench.command("train")
 @click.option("--config", "config_path", default=None, type=click.Path(dir_okay=False),
-              help="Preset TOML to time, e.g. pipelines/cpu/syn_vases_cpu.toml (default: the training configuration "
-                   "stored in the bundled model, found in the installed package).")
+              help="Preset TOML to time, e.g. pipelines/cpu/syn_vases_cpu.toml, or a .safetensors model whose stored "
+                   "configuration to time (default: the bundled model's, found in the installed package).")
 @click.option("--device", default="auto", show_default=True, type=click.Choice(["cpu", "cuda", "auto"]),
               help="Where to train; auto = cuda when available.")
 @click.option("--steps", default=5, show_default=True, type=click.IntRange(min=1), help="Timed steps (median).")
@@ -50,9 +50,10 @@ def render(device: str, sizes: str, batch: int, repeats: int, threads: int) -> N
 def train(config_path: str | None, device: str, steps: int, warmup: int, batch: int | None, threads: int | None,
           profile_path: str | None) -> None:
     """Seconds per full training step (model + discriminator, forward, backward, Adam) and peak memory."""
-    from radar_cli.train.benchmark import bench_train, bundled_config
+    from radar_cli.derender.run.predictor import bundled_checkpoint
+    from radar_cli.train.benchmark import bench_train
 
-    result = bench_train(config_path or bundled_config(), steps, warmup, batch, device, threads, profile_path)
+    result = bench_train(config_path or bundled_checkpoint(), steps, warmup, batch, device, threads, profile_path)
     click.echo(json.dumps(result, indent=2))
 
 

@@ -31,20 +31,13 @@ def elliptic_batch(config: RunConfig, batch_size: int, device: torch.device) -> 
     return Batch(image.to(device), mask.to(device), dt.to(device), pitch_label=labels)
 
 
-def bundled_config() -> RunConfig:
-    """The training configuration stored in the bundled model (the default preset of `radar bench train`)."""
-    from radar_cli.derender.predictor import bundled_checkpoint
-    from radar_cli.train.checkpoint import read_checkpoint
-
-    return read_checkpoint(bundled_checkpoint())[2]
-
-
 def bench_train(config: RunConfig | str | Path, steps: int = 5, warmup: int = 2, batch_size: int | None = None,
                 device: str = "auto", threads: int | None = None, profile: str | Path | None = None) -> dict:
     """Time full training steps (model + D forward, backward, Adam) of a preset.
 
     Args:
-        config: a RunConfig or the path of a pipelines/**/*.toml preset.
+        config: a RunConfig, the path of a pipelines/**/*.toml preset, or a model or checkpoint file
+            (.safetensors: the configuration stored in it).
         steps: timed steps (after `warmup` untimed ones).
         batch_size: overrides train.batch_size.
         device: "auto", "cpu" or "cuda".
@@ -56,7 +49,11 @@ def bench_train(config: RunConfig | str | Path, steps: int = 5, warmup: int = 2,
         {"preset", "device", "batch_size", "image_size", "threads", "sec_per_step", "steps_per_sec",
          "peak_memory_mb", "steps"}: peak memory is the CUDA allocator's peak on GPUs, the process's max RSS on CPU.
     """
-    if not isinstance(config, RunConfig):
+    if isinstance(config, (str, Path)) and Path(config).suffix == ".safetensors":
+        from radar_cli.model.weights import read_checkpoint
+
+        config = read_checkpoint(config)[2]
+    elif not isinstance(config, RunConfig):
         config = load_run_config(config)
     dev = D.pick_device(device)
     n_threads = threads if threads is not None else (config.train.threads or torch.get_num_threads())
