@@ -83,7 +83,7 @@ def test_rerun_redoes_a_half_written_object_to_the_same_bytes(photos: Path, tmp_
     before = object_files(tmp_path / "out")
     folder = tmp_path / "out" / "vase_04"
     (folder / "material.json").unlink()
-    (folder / ".albedo.png.x1y2.tmp.png").write_bytes(b"half")
+    (folder / ".albedo.png.x1y2z3w4.tmp.png").write_bytes(b"half")  # mkstemp: 8 random characters
     summary = derender([photos], predictor, options)
     assert summary.done == ["vase_04"] and len(summary.skipped) == N_INPUTS - 1
     assert object_files(tmp_path / "out") == before
