@@ -6,7 +6,9 @@ import io
 import json
 import math
 import os
+import re
 import tempfile
+import time
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterator
@@ -20,30 +22,74 @@ MAX_IMAGE_PIXELS = 100_000_000  # decompression-bomb limit for untrusted images
 Image.MAX_IMAGE_PIXELS = MAX_IMAGE_PIXELS
 
 
+TEMP_MARK = ".tmp"  # atomic_path's temporary files are named .<name>.<random>.tmp<suffix>
+
+
+def umask() -> int:
+    """The process's file-creation mask (read without changing it where Linux allows)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def ordinary_file_mode() -> int:
+    """The mode an ordinary `open(path, "w")` gives a new file under the current umask (0644 under 022)."""
+    return 0o666 & ~umask()
+
+
 @contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
-    """Yield a temporary path next to `path`; on success rename it over `path`, on failure remove it."""
+    """Yield a temporary path next to `path`; on success rename it over `path`, on failure remove it.
+
+    The file gets the mode an ordinary write would give it (mkstemp makes it 0600, unreadable by a web server)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp" + path.suffix)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=TEMP_MARK + path.suffix)
+    os.fchmod(fd, ordinary_file_mode())
     os.close(fd)
     tmp_path = Path(tmp)
     try:
         yield tmp_path
+        os.chmod(tmp_path, ordinary_file_mode())  # a writer that replaced the file (e.g. OpenCV) set its own
         os.replace(tmp_path, path)
     except BaseException:
         tmp_path.unlink(missing_ok=True)
         raise
 
 
-def remove_stale_temps(folder: str | Path) -> int:
-    """Delete the temporary files atomic_path left in `folder` when its process was killed mid-write (the
-    finished files are never touched); the number removed."""
+def is_temp_name(name: str) -> bool:
+    """True for the names atomic_path gives its temporary files: .<name>.<8 random characters>.tmp[.<suffix>]."""
+    return _TEMP_NAME.fullmatch(name) is not None
+
+
+_TEMP_NAME = re.compile(r"\..+\.[a-z0-9_]{8}" + re.escape(TEMP_MARK) + r"(\.[^./]*)?")
+
+
+def remove_stale_temps(folder: str | Path, recursive: bool = False, min_age_s: float = 0.0) -> int:
+    """Delete the temporary files atomic_path left in `folder` (and its sub-folders when `recursive`) when their
+    process was killed mid-write; finished files and files of other names are never touched. min_age_s: keep
+    temporary files modified more recently (another process sharing the folder may be writing them). The number
+    removed."""
     removed = 0
-    for tmp in Path(folder).glob(".*.tmp*"):
-        if tmp.is_file():
-            tmp.unlink(missing_ok=True)
-            removed += 1
+    now = time.time()
+    for root, dirs, files in os.walk(folder):
+        for name in files:
+            path = Path(root) / name
+            try:
+                if is_temp_name(name) and now - path.stat().st_mtime >= min_age_s:
+                    path.unlink()
+                    removed += 1
+            except FileNotFoundError:
+                continue  # removed meanwhile
+        if not recursive:
+            break
     return removed
 
 

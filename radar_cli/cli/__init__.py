@@ -30,9 +30,11 @@ COMMANDS: list[tuple[str, str, str, str]] = [
 
 
 class RadarUsageError(click.ClickException):
-    """A RadarError shown as one line `Error: ...` with exit code 2."""
+    """A RadarError shown as one line `Error: ...` on stderr, with the error's exit status (2 unless it says)."""
 
-    exit_code = 2
+    def __init__(self, error: RadarError) -> None:
+        super().__init__(str(error))
+        self.exit_code = error.exit_status
 
 
 class RadarGroup(click.Group):
@@ -56,7 +58,7 @@ class RadarGroup(click.Group):
         try:
             return super().invoke(ctx)
         except RadarError as e:
-            raise RadarUsageError(str(e)) from None
+            raise RadarUsageError(e) from None
 
 
 @click.group(cls=RadarGroup, context_settings={"help_option_names": ["-h", "--help"]})

@@ -36,21 +36,24 @@ def render(device: str, sizes: str, batch: int, repeats: int, threads: int) -> N
 
 
 @bench.command("train")
-@click.option("--config", "config_path", default="pipelines/cpu/syn_vases_cpu.toml", show_default=True,
-              type=click.Path(dir_okay=False), help="Preset TOML to time.")
-@click.option("--device", default="auto", show_default=True, type=click.Choice(["cpu", "cuda", "auto"]))
+@click.option("--config", "config_path", default=None, type=click.Path(dir_okay=False),
+              help="Preset TOML to time, e.g. pipelines/cpu/syn_vases_cpu.toml, or a .safetensors model whose stored "
+                   "configuration to time (default: the bundled model's, found in the installed package).")
+@click.option("--device", default="auto", show_default=True, type=click.Choice(["cpu", "cuda", "auto"]),
+              help="Where to train; auto = cuda when available.")
 @click.option("--steps", default=5, show_default=True, type=click.IntRange(min=1), help="Timed steps (median).")
 @click.option("--warmup", default=2, show_default=True, type=click.IntRange(min=0), help="Untimed first steps.")
 @click.option("--batch", default=None, type=click.IntRange(min=1), help="Batch size (default: the preset's).")
 @click.option("--threads", default=None, type=click.IntRange(min=1), help="CPU threads (default: the preset's).")
 @click.option("--profile", "profile_path", default=None, type=click.Path(dir_okay=False),
               help="Also write torch.profiler's operator tables of 3 more steps to this text file.")
-def train(config_path: str, device: str, steps: int, warmup: int, batch: int | None, threads: int | None,
+def train(config_path: str | None, device: str, steps: int, warmup: int, batch: int | None, threads: int | None,
           profile_path: str | None) -> None:
     """Seconds per full training step (model + discriminator, forward, backward, Adam) and peak memory."""
+    from radar_cli.derender.run.predictor import bundled_checkpoint
     from radar_cli.train.benchmark import bench_train
 
-    result = bench_train(config_path, steps, warmup, batch, device, threads, profile_path)
+    result = bench_train(config_path or bundled_checkpoint(), steps, warmup, batch, device, threads, profile_path)
     click.echo(json.dumps(result, indent=2))
 
 
@@ -59,7 +62,8 @@ def train(config_path: str, device: str, steps: int, warmup: int, batch: int | N
 @click.option("--long-side", default=4000, show_default=True, type=click.IntRange(min=64),
               help="Long edge of each photo in pixels.")
 @click.option("--size", default=256, show_default=True, type=click.IntRange(min=16), help="Crop side in pixels.")
-@click.option("--workers", default=2, show_default=True, type=click.IntRange(min=1))
+@click.option("--workers", default=2, show_default=True, type=click.IntRange(min=1),
+              help="Processes detecting and cropping photos (radar masks --workers).")
 def masks(photos: int, long_side: int, size: int, workers: int) -> None:
     """Photos per second through `radar masks` (decode, detect, GrabCut, crop, score, write)."""
     from radar_cli.masks.benchmark import bench_masks
@@ -70,7 +74,8 @@ def masks(photos: int, long_side: int, size: int, workers: int) -> None:
 @bench.command("synth")
 @click.option("--size", default=256, show_default=True, type=click.IntRange(16, 1024), help="Image side in pixels.")
 @click.option("--n", "n", default=120, show_default=True, type=click.IntRange(min=1), help="Samples to generate.")
-@click.option("--workers", default=2, show_default=True, type=click.IntRange(min=1))
+@click.option("--workers", default=2, show_default=True, type=click.IntRange(min=1),
+              help="Processes rendering samples (radar synth --workers).")
 @click.option("--shading-size", default=0, show_default=True, type=click.IntRange(min=0),
               help="Lighting grid side for the frontal third (0 = radar synth's default).")
 def synth(size: int, n: int, workers: int, shading_size: int) -> None:
@@ -87,7 +92,8 @@ def synth(size: int, n: int, workers: int, shading_size: int) -> None:
               help="Images through the network alone.")
 @click.option("--exports", default=4, show_default=True, type=click.IntRange(min=1),
               help="Images de-rendered end to end with every export.")
-@click.option("--batch-size", default=8, show_default=True, type=click.IntRange(min=1))
+@click.option("--batch-size", default=8, show_default=True, type=click.IntRange(min=1),
+              help="Images per network batch (radar derender --batch-size).")
 @click.option("--threads", default=1, show_default=True, type=click.IntRange(min=1), help="torch threads.")
 @click.option("--workers", default=2, show_default=True, type=click.IntRange(min=0),
               help="Threads cropping and exporting objects (radar derender --workers).")

@@ -76,7 +76,8 @@ RESOLUTION = ResolutionType()
                    f"[default: the output side, at least {MIN_VIEW_SIZE}].")
 @click.option("--env", "envs", multiple=True, type=click.Path(dir_okay=False, path_type=Path),
               help="Extra relighting environment map (.hdr, .exr, .png, .npy); repeatable.")
-@click.option("--batch-size", type=click.IntRange(1, 1024), default=8, show_default=True)
+@click.option("--batch-size", type=click.IntRange(1, 1024), default=8, show_default=True,
+              help="Images per network batch.")
 @click.option("--workers", type=click.IntRange(0, 64), default=2, show_default=True,
               help="Threads reading and cropping images, and exporting objects.")
 @click.option("--threads", type=click.IntRange(1, 256), default=1, show_default=True,
@@ -105,7 +106,8 @@ def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks
     summary = derender_sharded(list(inputs), load, options, device, say=lambda line: click.echo(line, err=True))
     if contact_sheet is not None and summary.index is not None and (summary.done or summary.skipped):
         click.echo(f"contact sheet: {write_contact_sheet(out, contact_sheet)}")
-    click.echo(summary.line())
+    if summary.printed:
+        click.echo(summary.line())
     if summary.index is not None:
         click.echo(f"gallery: {summary.index}")
     if summary.failures:

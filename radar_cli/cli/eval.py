@@ -6,6 +6,7 @@ from __future__ import annotations
 import click
 
 from radar_cli.evaluate.scorer import evaluate, markdown_table, report_json
+from radar_cli.errors import NothingToDoError
 from radar_cli.fileio import write_json
 
 
@@ -19,6 +20,8 @@ from radar_cli.fileio import write_json
 def eval_cmd(pred: str, gt: str, split: str, json_path: str | None, allow_missing: bool) -> None:
     """Score results with the paper's metrics (Table 2) and print them beside the paper's numbers."""
     report = evaluate(pred, gt, split)
+    if not report.scores:
+        raise NothingToDoError(f"{pred}: nothing scored against {gt} ({unscored(report)})")
     for item, problem in report.problems:
         click.echo(f"skipped {item}: {problem}", err=True)
     if report.results_without_truth:
@@ -35,6 +38,14 @@ def eval_cmd(pred: str, gt: str, split: str, json_path: str | None, allow_missin
                f"{len(report.truth_without_results)} without results")
     if report.skipped or (report.truth_without_results and not allow_missing) or not report.scores:
         raise SystemExit(1)
+
+
+def unscored(report) -> str:
+    """Why nothing was scored, in a few words (the first unreadable result named)."""
+    first = f": {report.problems[0][0]}: {report.problems[0][1]}" if report.problems else ""
+    return (f"{len(report.results_without_truth)} result(s) without ground truth, "
+            f"{len(report.truth_without_results)} sample(s) without a result, {len(report.problems)} unreadable"
+            + first)
 
 
 eval = eval_cmd  # noqa: A001  (the attribute name COMMANDS registers)

@@ -51,7 +51,8 @@ def fetch(query: str, out: Path, limit: int | None, department: int | None, publ
           block_wait: float, result_cap: int, page_size: int, progress: bool) -> None:
     """Harvest a Met Collection API query into OUT: search, object records, then validated images.
 
-    Resumable: rerun the same command after a crash or Ctrl-C. Exits 1 when objects failed.
+    Resumable: rerun the same command after a crash or Ctrl-C. Exits 1 when objects failed or the API could not
+    be reached (a run that harvested nothing leaves no folder behind).
     """
     api_client = ClientConfig(rate=rate, user_agent=user_agent, timeout=timeout, block_wait=block_wait)
     config = HarvestConfig(
@@ -61,6 +62,8 @@ def fetch(query: str, out: Path, limit: int | None, department: int | None, publ
         progress=progress)  # type: ignore[arg-type]
     summary = harvest(config)
     click.echo(summary.line())
+    if summary.aborted:
+        click.echo(f"Error: {summary.aborted}", err=True)
     if summary.interrupted:
         sys.exit(130)
     if summary.failed or summary.aborted:

@@ -18,8 +18,10 @@ from radar_cli.masks.quality import Thresholds
               help="Margin per side, fraction of the crop.")
 @click.option("--min-symmetry", default=Thresholds().min_symmetry, show_default=True,
               type=click.FloatRange(0.0, 1.0), help="Reject crops whose solid-of-revolution score is lower.")
-@click.option("--workers", default=1, show_default=True, type=click.IntRange(1, 64))
-@click.option("--detector", type=click.Choice(["classical", "onnx"]), default="classical", show_default=True)
+@click.option("--workers", default=1, show_default=True, type=click.IntRange(1, 64),
+              help="Processes working on photos in parallel.")
+@click.option("--detector", type=click.Choice(["classical", "onnx"]), default="classical", show_default=True,
+              help="classical: the backdrop-model detector; onnx: an object detector from --model.")
 @click.option("--model", type=click.Path(exists=True, dir_okay=False), help="ONNX model for --detector onnx.")
 @click.option("--no-contact-sheet", is_flag=True, help="Skip the PNG contact sheets.")
 def masks(data, out, size, margin, min_symmetry, workers, detector, model, no_contact_sheet) -> None:

@@ -26,11 +26,14 @@ def split_sizes(split: str, n: int | None) -> dict[str, int]:
               help="Samples in --split (with 'both': train, and test in the paper's proportion). "
                    "Default: 4115 train, 460 test.")
 @click.option("--size", type=click.IntRange(16, 1024), default=256, show_default=True, help="Image side (px).")
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True)
-@click.option("--split", type=click.Choice(["both", "train", "test"]), default="both", show_default=True)
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Random seed: the same seed, size and settings give the same samples.")
+@click.option("--split", type=click.Choice(["both", "train", "test"]), default="both", show_default=True,
+              help="Which split to write (both: train and test).")
 @click.option("--textures", type=click.Path(exists=True, file_okay=False), default=None,
               help="Folder of texture images to use instead of procedural pottery textures.")
-@click.option("--workers", type=click.IntRange(min=1), default=os.cpu_count() or 1, show_default="CPU count")
+@click.option("--workers", type=click.IntRange(min=1), default=os.cpu_count() or 1, show_default="CPU count",
+              help="Processes rendering samples.")
 @click.option("--background", type=click.FloatRange(0, 1), default=1.0, show_default=True,
               help="Grey level of the plain background.")
 @click.option("--tex-size", type=click.IntRange(min=0), default=0, help="Albedo map rows (0 = image size).")

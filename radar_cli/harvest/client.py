@@ -11,6 +11,7 @@ from __future__ import annotations
 import email.utils
 import json
 import random
+import re
 import threading
 import time
 from dataclasses import dataclass, field
@@ -36,8 +37,15 @@ class ClientConfig:
     """Sent with every request; should name the tool and a contact."""
     timeout: float = 30.0
     """Seconds for one whole attempt: connect, headers and the full body."""
+    connect_timeout: float = 5.0
+    """Seconds to establish the connection (at most `timeout`)."""
     retries: int = 5
     """Extra attempts after the first for 5xx, 429, timeouts and truncated bodies."""
+    connect_retries: int = 1
+    """Extra attempts, `connect_wait` apart, when the host cannot be reached at all (connection refused, unknown
+    name, connect timeout): a wrong --api-url or a host that is down ends the run in seconds."""
+    connect_wait: float = 0.5
+    """Seconds between attempts to reach an unreachable host."""
     backoff_base: float = 1.0
     """Full-jitter backoff: sleep uniform(0, min(backoff_cap, backoff_base * 2**attempt)) seconds."""
     backoff_cap: float = 60.0
@@ -79,10 +87,11 @@ class Reply:
 class _Retry(Exception):
     """Internal: this attempt failed in a retryable way; `wait` overrides the backoff when set."""
 
-    def __init__(self, message: str, wait: float | None = None, block: bool = False):
+    def __init__(self, message: str, wait: float | None = None, block: bool = False, connect: bool = False):
         super().__init__(message)
         self.wait = wait
         self.block = block
+        self.connect = connect
 
 
 @dataclass
@@ -119,6 +128,17 @@ def parse_retry_after(value: str | None, now: float | None = None) -> float | No
     except (TypeError, ValueError):
         return None
     return max(0.0, when.timestamp() - (time.time() if now is None else now))
+
+
+def _unreachable(error: requests.RequestException) -> str | None:
+    """Why no connection could be made (the operating system's words, e.g. `Connection refused`), or None when
+    the error came after the connection was made (a reset, a read timeout)."""
+    reason = error.args[0].reason if error.args and isinstance(error.args[0], urllib3.exceptions.MaxRetryError) \
+        else None
+    if not isinstance(reason, urllib3.exceptions.ConnectTimeoutError):  # refused, unknown name, connect timeout
+        return None
+    match = re.search(r"\[Errno -?\d+\] ([^'\")\]]+)", str(reason))
+    return match.group(1).strip() if match else type(reason).__name__
 
 
 def looks_like_json(body: bytes) -> bool:
@@ -169,7 +189,7 @@ class HttpClient:
         """
         if not url.startswith(("http://", "https://")):
             raise FetchError(f"{url}: not an http(s) URL")
-        attempt, blocks = 0, 0
+        attempt, blocks, unreachable = 0, 0, 0
         while True:
             try:
                 return self._attempt(url, params, expect_json, headers)
@@ -179,6 +199,11 @@ class HttpClient:
                     if blocks > self.config.block_retries:
                         raise Blocked(f"{url}: blocked {blocks} times in a row ({e})") from None
                     wait = self.config.block_wait * (1.0 + 0.5 * random.random())
+                elif e.connect:
+                    unreachable += 1
+                    if unreachable > self.config.connect_retries:
+                        raise FetchError(f"{url}: cannot connect ({e}; tried {unreachable} times)") from None
+                    wait = self.config.connect_wait
                 else:
                     attempt += 1
                     if attempt > self.config.retries:
@@ -196,13 +221,17 @@ class HttpClient:
         self.pacer.wait()
         self.requests_sent += 1
         deadline = time.monotonic() + self.config.timeout
+        connect = min(self.config.connect_timeout, self.config.timeout)
         try:
             with self.session.get(url, params=params, headers=headers, stream=True,
-                                  timeout=(self.config.timeout, self.config.timeout)) as r:
+                                  timeout=(connect, self.config.timeout)) as r:
                 body = self._read_body(r, deadline)
                 reply = Reply(r.url, r.status_code, dict(r.headers), body)
+        except requests.ConnectTimeout:
+            raise _Retry(f"no connection within {connect:g} s", connect=True) from None
         except (requests.Timeout, requests.ConnectionError) as e:
-            raise _Retry(f"{type(e).__name__}") from None
+            unreachable = _unreachable(e)
+            raise _Retry(unreachable or type(e).__name__, connect=unreachable is not None) from None
         except (requests.RequestException, urllib3.exceptions.HTTPError) as e:  # truncated or undecodable body
             raise _Retry(f"broken body ({type(e).__name__})") from None
         return self._classify(reply, expect_json)

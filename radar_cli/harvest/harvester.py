@@ -5,7 +5,7 @@ Layout of the output folder:
     DATA/met/<id>.json         the object record exactly as the API sent it
     DATA/met/<id>.jpg          the validated image (name from the numeric id only)
     DATA/failures.csv          object_id,error of the objects that failed (rewritten at the end of each run)
-    DATA/.fetch.lock           held while a run writes the folder (one run per folder at a time)
+    DATA/.fetch.lock           held while a run writes the folder (one run per folder at a time), then removed
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import fcntl
 import io
+import os
 from contextlib import contextmanager
 from collections import Counter
 from dataclasses import dataclass, field
@@ -22,13 +23,14 @@ from typing import Callable, Iterator, Literal
 from tqdm import tqdm
 
 from radar_cli.errors import InputError, NetworkError
-from radar_cli.fileio import write_bytes, write_text
-from radar_cli.harvest.catalog import Catalog, open_catalog
+from radar_cli.fileio import remove_stale_temps, write_bytes, write_text
+from radar_cli.harvest.catalog import CATALOG_NAME, Catalog, open_catalog
 from radar_cli.harvest.client import BodyTooLarge, ClientConfig, FetchError, HttpClient
 from radar_cli.harvest.images import MAX_PIXELS, ImageRejected, store_image
 from radar_cli.harvest.met_api import DEFAULT_API_URL, MetApi
 
 OBJECTS_DIR = "met"
+LOCK_FILE = ".fetch.lock"
 MAX_CONSECUTIVE_FAILURES = 20  # an outage: stop instead of marking every remaining object failed
 
 
@@ -257,13 +259,6 @@ class Harvester:
         self.summary.images_fetched += 1
 
 
-def _remove_partial_files(folder: Path) -> None:
-    """Delete temp files left by a killed run (atomic writes never leave partial final files)."""
-    if folder.is_dir():
-        for tmp in folder.glob(".*.tmp*"):
-            tmp.unlink(missing_ok=True)
-
-
 def _write_failures(catalog: Catalog, out: Path) -> None:
     rows = [r for r in catalog.rows() if r["state"] == "failed"]
     path = out / "failures.csv"
@@ -279,13 +274,20 @@ def _write_failures(catalog: Catalog, out: Path) -> None:
 
 @contextmanager
 def _only_run(out: Path) -> Iterator[None]:
-    """Hold an exclusive lock on the folder for the run (released by the OS even on SIGKILL)."""
-    with open(out / ".fetch.lock", "w") as lock:
+    """Hold an exclusive lock on the folder for the run (released by the OS even on SIGKILL); the lock file is
+    removed when the run ends."""
+    path = out / LOCK_FILE
+    with open(path, "w") as lock:
         try:
             fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
+            if os.fstat(lock.fileno()).st_ino != os.stat(path).st_ino:  # a run that just ended removed it
+                raise BlockingIOError
+        except (BlockingIOError, FileNotFoundError):
             raise InputError(f"{out}: another `radar fetch` is writing this folder") from None
-        yield
+        try:
+            yield
+        finally:
+            path.unlink(missing_ok=True)  # still holding the lock: no other run can have taken it
 
 
 def harvest(config: HarvestConfig, log: Callable[[str], None] = tqdm.write) -> Summary:
@@ -299,18 +301,40 @@ def harvest(config: HarvestConfig, log: Callable[[str], None] = tqdm.write) -> S
 
     Returns:
         The run summary (catalog totals included).
+
+    Raises:
+        InputError: --api-url is not an http(s) URL, or the folder cannot be written. NetworkError: the API failed
+            before anything was harvested; the folder is then left as it was (a new one is not created).
     """
     out = Path(config.out)
+    if not config.api_url.startswith(("http://", "https://")):
+        raise InputError(f"--api-url {config.api_url!r}: not an http(s) URL")
+    created = [p for p in (out, *out.parents) if not p.exists()]
+    fresh = not (out / CATALOG_NAME).exists()
     try:
         out.mkdir(parents=True, exist_ok=True)
         with _only_run(out):
-            return _harvest(config, out, log)
+            return _harvest(config, out, log, fresh)
+    except NetworkError:
+        _remove_run(out, created)
+        raise
     except OSError as e:  # disk full, permissions: the catalog stays consistent, a rerun resumes
         raise InputError(f"{out}: cannot write the harvest ({e})") from None
 
 
-def _harvest(config: HarvestConfig, out: Path, log: Callable[[str], None]) -> Summary:
-    _remove_partial_files(out / OBJECTS_DIR)
+def _remove_run(out: Path, created: list[Path]) -> None:
+    """Remove the empty catalog and the folders of a run that harvested nothing."""
+    for suffix in ("", "-wal", "-shm"):
+        (out / (CATALOG_NAME + suffix)).unlink(missing_ok=True)
+    for folder in created:  # deepest first
+        try:
+            folder.rmdir()
+        except OSError:
+            break
+
+
+def _harvest(config: HarvestConfig, out: Path, log: Callable[[str], None], fresh: bool) -> Summary:
+    remove_stale_temps(out, recursive=True)  # what a killed run was writing
     with open_catalog(out) as catalog:
         harvester = Harvester(config, catalog, log)
         summary = harvester.summary
@@ -321,6 +345,8 @@ def _harvest(config: HarvestConfig, out: Path, log: Callable[[str], None]) -> Su
         except KeyboardInterrupt:
             summary.interrupted = True
         except NetworkError as e:
+            if fresh and not any(catalog.counts().values()):
+                raise  # nothing harvested: no catalog is left behind
             summary.aborted = str(e)
         summary.counts = catalog.counts()
         summary.skipped = catalog.skip_reasons()

@@ -13,6 +13,7 @@ import hashlib
 import io
 import json
 import multiprocessing
+import sys
 import time
 from collections import Counter
 from dataclasses import asdict, dataclass, field
@@ -23,8 +24,8 @@ import cv2
 from tqdm import tqdm
 
 from radar_cli.dataset import sample_ref, safe_id, write_sample
-from radar_cli.errors import InputError
-from radar_cli.fileio import write_json, write_text
+from radar_cli.errors import InputError, NothingToDoError
+from radar_cli.fileio import remove_stale_temps, write_json, write_text
 from radar_cli.masks.contact_sheet import write_sheets
 from radar_cli.masks.pipeline import Crop, Settings, process_photo
 
@@ -171,9 +172,18 @@ def prepare(data_dir: str | Path, out: str | Path, settings: Settings = Settings
 
     Returns:
         The run's Summary over all records (this run's and earlier ones').
+
+    Raises:
+        InputError: `out` is `data_dir`; NothingToDoError: `data_dir` holds no photograph (nothing is written).
     """
     out = Path(out)
+    if out.resolve() == Path(data_dir).resolve():
+        raise InputError(f"{out}: --out is the photo folder; choose a dataset folder outside it")
     sources = list_sources(data_dir, exclude=out)
+    if not sources:
+        raise NothingToDoError(f"{data_dir}: no photographs ({', '.join(PHOTO_EXTENSIONS)})")
+    if out.is_dir():
+        remove_stale_temps(out, recursive=True)  # what a killed run was writing
     if spec.name == "onnx":
         _detector(spec)  # fail early, in this process, on a missing runtime or a bad model
     done = {p.stem for p in (out / RECORDS).glob("*.json")}
@@ -181,7 +191,7 @@ def prepare(data_dir: str | Path, out: str | Path, settings: Settings = Settings
     t0 = time.perf_counter()
     for record in tqdm(_run(jobs, workers), total=len(jobs), desc="masks", unit="photo", disable=not progress):
         if record["status"] == "failed":
-            tqdm.write(f"skipped: {record['reason']}")
+            tqdm.write(record["reason"], file=sys.stderr)
     elapsed = time.perf_counter() - t0
     records = [json.loads(p.read_text()) for p in sorted((out / RECORDS).glob("*.json"))]
     summary = _summarise(records, len(sources) - len(jobs), elapsed, len(jobs))

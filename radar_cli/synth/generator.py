@@ -14,6 +14,7 @@ import json
 import multiprocessing
 import os
 import shutil
+import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,7 +28,7 @@ from radar_cli.allocator import keep_freed_memory
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig, to_dict
 from radar_cli.dataset import IMAGE_FILE, MASK_FILE, SPLITS, sample_images, sample_ref
 from radar_cli.errors import ConfigError, InputError, RadarError
-from radar_cli.fileio import encode_json, encode_npy, encode_png_fast, write_json, write_text
+from radar_cli.fileio import encode_json, encode_npy, encode_png_fast, remove_stale_temps, write_json, write_text
 from radar_cli.synth import layout
 from radar_cli.synth.lighting import bake_env, sample_lobes
 from radar_cli.synth.render import env_preview, render_sample
@@ -230,8 +231,9 @@ def _check_settings(root: Path, cfg: SynthConfig) -> None:
 
 
 def _clean_partial(root: Path) -> None:
-    """Remove temporary folders left by a killed run."""
+    """Remove the temporary folders and files left by a killed run."""
     shutil.rmtree(root / PARTIAL_DIR, ignore_errors=True)
+    remove_stale_temps(root)
 
 
 def generate(out: str | Path, splits: dict[str, int], cfg: SynthConfig = SynthConfig(), workers: int = 1,
@@ -252,8 +254,8 @@ def generate(out: str | Path, splits: dict[str, int], cfg: SynthConfig = SynthCo
     if textures:
         textures = [p.resolve() for p in textures]
     root.mkdir(parents=True, exist_ok=True)
-    _check_settings(root, cfg)
     _clean_partial(root)
+    _check_settings(root, cfg)
     summary = SynthSummary(workers=max(1, workers))
     jobs = []
     for split, n in splits.items():
@@ -269,7 +271,7 @@ def generate(out: str | Path, splits: dict[str, int], cfg: SynthConfig = SynthCo
             summary.first_seconds = time.perf_counter() - start
         if problem:
             summary.failed.append((split, sid, problem))
-            tqdm.write(f"{root / split / sid}: {problem}")
+            tqdm.write(f"{root / split / sid}: {problem}", file=sys.stderr)
         else:
             summary.written += 1
         bar.update(1)

@@ -19,15 +19,16 @@ from radar_cli.train.trainer import build_state, train_step
 
 
 def elliptic_batch(config: RunConfig, batch_size: int, device: torch.device) -> Batch:
-    """Random B x 3 x S x S images with one elliptic B x S x S mask (and its distance transform): the work of a
-    training step without a dataset."""
+    """Random B x 3 x S x S images with one elliptic B x S x S mask (and its distance transform), and B pitch
+    labels of 10 deg when the preset self-trains on pitch: the work of a training step without a dataset."""
     size = config.model.render.image_size
     c = (torch.arange(size) + 0.5) / size * 2 - 1
     yy, xx = torch.meshgrid(c, c, indexing="ij")
     mask = ((xx / 0.45) ** 2 + (yy / 0.8) ** 2 < 1).float().expand(batch_size, size, size).contiguous()
     dt = torch.from_numpy(distance_transform(mask[0].numpy() > 0)).expand_as(mask).contiguous()
     image = torch.rand(batch_size, 3, size, size, generator=torch.Generator().manual_seed(0))
-    return Batch(image.to(device), mask.to(device), dt.to(device))
+    labels = torch.full((batch_size,), 10.0, device=device) if config.loss.pitch_label_weight > 0 else None
+    return Batch(image.to(device), mask.to(device), dt.to(device), pitch_label=labels)
 
 
 def bench_train(config: RunConfig | str | Path, steps: int = 5, warmup: int = 2, batch_size: int | None = None,
@@ -35,7 +36,8 @@ def bench_train(config: RunConfig | str | Path, steps: int = 5, warmup: int = 2,
     """Time full training steps (model + D forward, backward, Adam) of a preset.
 
     Args:
-        config: a RunConfig or the path of a pipelines/**/*.toml preset.
+        config: a RunConfig, the path of a pipelines/**/*.toml preset, or a model or checkpoint file
+            (.safetensors: the configuration stored in it).
         steps: timed steps (after `warmup` untimed ones).
         batch_size: overrides train.batch_size.
         device: "auto", "cpu" or "cuda".
@@ -47,7 +49,11 @@ def bench_train(config: RunConfig | str | Path, steps: int = 5, warmup: int = 2,
         {"preset", "device", "batch_size", "image_size", "threads", "sec_per_step", "steps_per_sec",
          "peak_memory_mb", "steps"}: peak memory is the CUDA allocator's peak on GPUs, the process's max RSS on CPU.
     """
-    if not isinstance(config, RunConfig):
+    if isinstance(config, (str, Path)) and Path(config).suffix == ".safetensors":
+        from radar_cli.model.weights import read_checkpoint
+
+        config = read_checkpoint(config)[2]
+    elif not isinstance(config, RunConfig):
         config = load_run_config(config)
     dev = D.pick_device(device)
     n_threads = threads if threads is not None else (config.train.threads or torch.get_num_threads())

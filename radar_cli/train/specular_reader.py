@@ -23,7 +23,7 @@ from tqdm import tqdm
 
 from radar_cli.config import to_dict
 from radar_cli.errors import CheckpointError, ConfigError, InputError
-from radar_cli.fileio import write_image
+from radar_cli.fileio import remove_stale_temps, write_image
 from radar_cli.model.specular_reader import SpecularReader
 from radar_cli.threads import torch_threads
 from radar_cli.model.weights import load_model, read_specular_reader
@@ -135,6 +135,7 @@ def train_reader(config: ReaderConfig, data_dir: str | Path, out_dir: str | Path
     config.validate()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    remove_stale_temps(out, recursive=True)  # what a killed run was writing
     start_time = time.perf_counter()
     torch.manual_seed(config.seed)
     with torch_threads(config.threads):

@@ -16,6 +16,7 @@ import torch
 from tqdm import tqdm
 
 from radar_cli.errors import InputError, RadarError
+from radar_cli.fileio import remove_stale_temps
 from radar_cli.model.config import RunConfig, TrainConfig
 from radar_cli.model.discriminator import PatchDiscriminator
 from radar_cli.model.losses import sad_discriminator_loss
@@ -180,6 +181,8 @@ def train(config: RunConfig, data_dir: str | Path, run_dir: str | Path, resume: 
         torch.set_num_threads(config.train.threads)
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
+    if info.is_main:  # rank 0 writes the run folder: whatever a killed run was writing there
+        remove_stale_temps(run_dir, recursive=True)
     try:
         return _run(config, Path(data_dir), run_dir, resume, overfit, info, progress, init, max_minutes,
                     pitch_labels)

@@ -74,6 +74,31 @@ def test_relight_bad_folder_and_env_one_line(obj: Path, tmp_path: Path) -> None:
     assert bad_env.exit_code == 2 and "env.npy" in bad_env.output
 
 
+@pytest.mark.parametrize("name", ["studio", "overcast", "sunset", "two_lights"])
+def test_relight_takes_the_builtin_environments_by_name(obj: Path, tmp_path: Path, name: str) -> None:
+    env = read_state(obj).env[0].numpy()
+    np.save(tmp_path / "map.npy", builtin_environments(*env.shape)[name])
+    runner = CliRunner()
+    for spec, out in ((name, "by_name.png"), (str(tmp_path / "map.npy"), "by_file.png")):
+        result = runner.invoke(cli, ["relight", str(obj), "--env", spec, "--out", str(tmp_path / out)])
+        assert result.exit_code == 0, result.output
+    by_name = _read(tmp_path / "by_name.png")
+    assert np.array_equal(by_name, _read(tmp_path / "by_file.png"))
+    assert np.abs(by_name - _read(obj / "recon.png")).mean() > 0.5  # not the object's own lighting
+
+
+def test_relight_refuses_unknown_names_non_image_outputs_and_missing_folders(obj: Path, tmp_path: Path) -> None:
+    runner = CliRunner()
+    unknown = runner.invoke(cli, ["relight", str(obj), "--env", "moonlight", "--out", str(tmp_path / "a.png")])
+    assert unknown.exit_code == 2 and "moonlight: no such environment (built-in: studio" in unknown.stderr
+    text = runner.invoke(cli, ["relight", str(obj), "--env", "studio", "--out", str(tmp_path / "x.txt")])
+    assert text.exit_code == 2 and "x.txt: not an image file name" in text.stderr
+    missing = tmp_path / "no" / "such"
+    nested = runner.invoke(cli, ["relight", str(obj), "--env", "studio", "--out", str(missing / "x.png")])
+    assert nested.exit_code == 2 and f"{missing}: no such folder" in nested.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing written, no folder made
+
+
 def test_view_renderer_equals_render_view(obj: Path) -> None:
     state = read_state(obj)
     view = ViewRenderer(state, 40, pitch_deg=5.0)

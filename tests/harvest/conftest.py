@@ -1,8 +1,9 @@
-"""A fake Met Collection API on 127.0.0.1 that replays the recorded response shapes and injects faults.
+"""A fake Met Collection API on 127.0.0.1 that serves object records and injects faults.
 
-Object records are the real recorded responses from ../shared/data/met_api/ with `objectID`, image URLs and a
-few fields rewritten per fake object. Faults are queued per URL path and consumed one per request, so
-"fails twice, then works" is `server.fault("/api/v1/objects/7", "500", "503")`.
+Object records are built by the tests in the schema of the API's recorded responses (met_records.py), with
+`objectID`, image URLs and a few fields rewritten per fake object; every test runs on them, and once more on the
+real recorded responses from ../shared/data/met_api/ when those are present. Faults are queued per URL path and
+consumed one per request, so "fails twice, then works" is `server.fault("/api/v1/objects/7", "500", "503")`.
 """
 
 from __future__ import annotations
@@ -23,6 +24,8 @@ from PIL import Image
 
 from radar_cli.harvest.client import ClientConfig
 from radar_cli.harvest.harvester import HarvestConfig
+
+from . import met_records
 
 TEMPLATES = {  # recorded responses: two public-domain objects with images, one not public domain
     "pd_scroll": "objects_45734_quail_and_millet_2020.json",
@@ -215,13 +218,21 @@ class QuietServer(ThreadingHTTPServer):
         pass
 
 
-@pytest.fixture
-def met_server(shared_data: Callable[..., Path]) -> Iterator[FakeMet]:
-    """A running fake Met API (skips when the recorded responses are not present)."""
-    folder = shared_data("data", "met_api")
+def recorded_responses(folder: Path) -> FakeMet:
+    """A FakeMet serving the recorded responses of `folder` (../shared/data/met_api)."""
     templates = {k: json.loads((folder / name).read_text(encoding="utf-8")) for k, name in TEMPLATES.items()}
     departments = json.loads((folder / DEPARTMENTS).read_text(encoding="utf-8"))["departments"]
-    met = FakeMet(templates, departments, (folder / BLOCK_PAGE).read_bytes())
+    return FakeMet(templates, departments, (folder / BLOCK_PAGE).read_bytes())
+
+
+@pytest.fixture(params=["built", "recorded"])
+def met_server(request: pytest.FixtureRequest, shared_data: Callable[..., Path]) -> Iterator[FakeMet]:
+    """A running fake Met API on the tests' own records, then on the recorded ones (skipped when absent)."""
+    if request.param == "recorded":
+        met = recorded_responses(shared_data("data", "met_api"))
+    else:
+        met = FakeMet({kind: met_records.object_record(kind) for kind in met_records.KINDS},
+                      met_records.departments(), met_records.BLOCK_PAGE)
     server = QuietServer(("127.0.0.1", 0), type("Handler", (MetHandler,), {"met": met}))
     met.url = f"http://127.0.0.1:{server.server_address[1]}"
     thread = threading.Thread(target=server.serve_forever, args=(0.05,), daemon=True)

@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import socket
+import time
+
 from click.testing import CliRunner
 
+from radar_cli.cli import cli
 from radar_cli.cli.fetch import fetch
 from radar_cli.harvest.catalog import iter_images
 
@@ -43,11 +47,58 @@ def test_fetch_rejects_bad_since_and_missing_ids_file(met_server, tmp_path):
 
 
 def test_bad_ids_file_is_one_line_error_through_the_radar_group(met_server, tmp_path):
-    from radar_cli.cli import cli
-
     ids = tmp_path / "ids.txt"
     ids.write_text("12\nabc\n")
     result = CliRunner().invoke(cli, ["fetch", "--out", str(tmp_path / "data"), "--ids", str(ids),
                                       "--api-url", met_server.api_url, "--no-progress"])
     assert result.exit_code == 2
     assert result.output.strip().endswith("ids.txt:2: not an object id: 'abc'")
+
+
+def _closed_port() -> int:
+    """A port on 127.0.0.1 that nothing listens on (connections are refused)."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_refused_connection_fails_in_one_stderr_line_within_seconds_leaving_nothing(tmp_path):
+    out = tmp_path / "new" / "data"
+    start = time.monotonic()
+    result = CliRunner().invoke(cli, ["fetch", "--out", str(out), "--api-url", f"http://127.0.0.1:{_closed_port()}",
+                                      "--no-progress"])
+    elapsed = time.monotonic() - start
+    assert result.exit_code == 1 and result.stdout == ""
+    assert result.stderr.count("\n") == 1 and "cannot connect (Connection refused" in result.stderr
+    assert elapsed < 2.5, elapsed  # one retry, no long backoff
+    assert not (tmp_path / "new").exists()  # no folder, no .fetch.lock, no empty catalog.sqlite
+
+
+def test_refused_connection_keeps_an_existing_folder_as_it_was(tmp_path):
+    out = tmp_path / "data"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    result = CliRunner().invoke(cli, ["fetch", "--out", str(out), "--api-url", f"http://127.0.0.1:{_closed_port()}",
+                                      "--no-progress"])
+    assert result.exit_code == 1
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+def test_api_url_that_is_not_a_url_creates_nothing(tmp_path):
+    result = CliRunner().invoke(cli, ["fetch", "--out", str(tmp_path / "data"), "--api-url", "notaurl"])
+    assert result.exit_code == 2 and result.stdout == ""
+    assert result.stderr.strip() == "Error: --api-url 'notaurl': not an http(s) URL"
+    assert not (tmp_path / "data").exists()
+
+
+def test_a_run_removes_its_lock_and_the_temp_files_of_a_killed_one(met_server, tmp_path):
+    met_server.add(3)
+    out = tmp_path / "data"
+    (out / "met").mkdir(parents=True)
+    leftovers = [out / ".failures.csv.ab12cd34.tmp.csv", out / "met" / ".3.json.zz_99xyz.tmp.json"]
+    for path in leftovers:
+        path.write_bytes(b"partial")
+    (out / ".notes.tmp").write_text("not radar's")
+    assert run(met_server, out).exit_code == 0
+    assert not any(p.exists() for p in leftovers) and (out / ".notes.tmp").is_file()
+    assert not (out / ".fetch.lock").exists() and (out / "catalog.sqlite").is_file()

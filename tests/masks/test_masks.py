@@ -22,20 +22,15 @@ from radar_cli.masks.quality import Thresholds, score_mask, sor_score
 from radar_cli.masks.refine import iou
 from radar_cli.masks.synthetic import NON_SOR, composite, non_sor_mask, render_vases, sor_mask
 
-REAL = Path(__file__).resolve().parents[3] / "shared" / "data" / "real_vases"
-
-
 @pytest.fixture(scope="module")
 def vases():
     return render_vases(3, 128, seed=3)
-
 
 def _crop_iou(photo: np.ndarray, truth: np.ndarray) -> float:
     found = process_image(photo, Settings())
     assert found, "nothing detected"
     best = max(found, key=lambda c: int(c.mask.sum()))
     return iou(best.mask, crops.cut(truth.astype(np.float32), best.box, 256) > 0.5)
-
 
 @pytest.mark.parametrize("kind,floor", [("plain", 0.95), ("gradient", 0.95), ("textured", 0.85),
                                         ("label", 0.93)])
@@ -44,7 +39,6 @@ def test_composite_iou(vases, kind, floor):
     rng = np.random.default_rng(5)
     scores = [_crop_iou(*composite(image[i], alpha[i], mask[i], kind, rng)) for i in range(3)]
     assert np.mean(scores) >= floor, scores
-
 
 def test_crop_geometry_object_fills_085():
     mask = np.zeros((400, 300), bool)
@@ -57,13 +51,11 @@ def test_crop_geometry_object_fills_085():
     ys = np.nonzero(out.any(1))[0]
     assert abs((ys.max() - ys.min() + 1) / 128 - 0.85) < 0.02
 
-
 def test_crop_pads_outside_the_photo():
     img = np.full((50, 50, 3), 7, np.uint8)
     out = crops.cut(img, crops.CropBox(-20, -20, 100), 64)
     assert out.shape == (64, 64, 3) and (out == 7).all()
     assert crops.valid_region(crops.CropBox(-20, -20, 100), img.shape, 100) == (20, 20, 70, 70)
-
 
 def test_symmetry_separates_sor_from_other_shapes():
     rng = np.random.default_rng(11)
@@ -72,25 +64,21 @@ def test_symmetry_separates_sor_from_other_shapes():
     other = [sor_score(non_sor_mask(NON_SOR[i % len(NON_SOR)], 128, rng)) < limit for i in range(25)]
     assert np.mean(sor + other) >= 0.9
 
-
 def test_rendered_vase_scores(vases):
     for m in vases[2]:
         s = score_mask(m)
         assert s["symmetry"] >= Thresholds().min_symmetry and s["solidity"] > 0.6 and not s["touches_border"]
-
 
 def test_split_is_deterministic_and_roughly_78_percent():
     splits = [split_for(f"met_{i}") for i in range(2000)]
     assert splits == [split_for(f"met_{i}") for i in range(2000)]
     assert 0.74 < splits.count("train") / 2000 < 0.82
 
-
 def _png_claiming(width: int, height: int) -> bytes:
     """A PNG header announcing a huge image, with no pixel data (decompression-bomb probe)."""
     def chunk(tag: bytes, data: bytes) -> bytes:
         return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data))
     return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
-
 
 def _studio(rng: np.random.Generator, size=(240, 200)) -> np.ndarray:
     h, w = size
@@ -99,7 +87,6 @@ def _studio(rng: np.random.Generator, size=(240, 200)) -> np.ndarray:
     top, left = int(h * 0.15), (w - m.shape[1]) // 2
     img[top : top + m.shape[0], left : left + m.shape[1]][m] = (120, 60, 30)
     return img
-
 
 def _bad_folder(folder: Path) -> None:
     rng = np.random.default_rng(0)
@@ -115,7 +102,6 @@ def _bad_folder(folder: Path) -> None:
     Image.fromarray(good[:20, :20]).save(folder / "tiny.png")
     Image.fromarray(np.full((100, 100, 3), 128, np.uint8)).save(folder / "flat.png")
     (folder / "huge.png").write_bytes(_png_claiming(30000, 30000))
-
 
 def test_bad_inputs_are_recorded_and_the_batch_goes_on(tmp_path):
     src = tmp_path / "photos"
@@ -137,7 +123,6 @@ def test_bad_inputs_are_recorded_and_the_batch_goes_on(tmp_path):
                            for p in samples)
     assert (tmp_path / "out" / "contact_sheet-001.png").is_file()
 
-
 def test_resume_skips_finished_photos(tmp_path):
     src = tmp_path / "photos"
     src.mkdir()
@@ -152,7 +137,6 @@ def test_resume_skips_finished_photos(tmp_path):
     second = prepare(src, tmp_path / "out", progress=False, contact_sheet=False, workers=2)
     assert second.skipped_done == 3 and second.photos == 4
 
-
 def test_onnx_detector_reports_missing_runtime_or_bad_model(tmp_path):
     from radar_cli.masks.onnx import OnnxDetector
 
@@ -161,24 +145,21 @@ def test_onnx_detector_reports_missing_runtime_or_bad_model(tmp_path):
     with pytest.raises(InputError):
         OnnxDetector(bad)
 
-
-@pytest.mark.skipif(not REAL.is_dir(), reason="real photos not present")
-def test_real_photos_give_one_plausible_crop_each():
+def test_real_photos_give_one_plausible_crop_each(shared_data):
     from radar_cli.masks.pipeline import process_photo
 
+    real = shared_data("data", "real_vases")
     for name in ("met_gr_DP117199.jpg", "met_gr_DP107639.jpg"):
-        found = process_photo(REAL / name, Settings())
+        found = process_photo(real / name, Settings())
         assert len(found) == 1
         s = found[0].scores
         assert 0.2 < s["area"] < 0.6 and s["symmetry"] > 0.8, s
-
 
 def test_bench_masks_smoke():
     from radar_cli.masks.benchmark import bench_masks
 
     result = bench_masks(n_photos=2, long_side=1600, workers=1)
     assert result["photos"] == 2 and result["photos_per_second"] > 0 and result["cpu_seconds_per_photo"] > 0
-
 
 def test_big_jpeg_is_draft_decoded_and_box_is_in_original_pixels(tmp_path):
     from radar_cli.masks.pipeline import load_photo, process_photo

@@ -136,6 +136,17 @@ def load_environment(path: str | Path, height: int, width: int) -> np.ndarray:
     return np.ascontiguousarray(arr, np.float32)
 
 
+def named_or_file_environment(spec: str | Path, height: int, width: int) -> np.ndarray:
+    """A built-in environment by name (studio, sunset, overcast, two_lights) or a map file (load_environment);
+    an existing file wins over a name."""
+    builtin = builtin_environments(height, width)
+    if str(spec) in builtin and not Path(spec).is_file():
+        return builtin[str(spec)]
+    if not Path(spec).is_file() and not Path(spec).suffix:
+        raise InputError(f"{spec}: no such environment (built-in: {', '.join(builtin)}; or a map file)")
+    return load_environment(spec, height, width)
+
+
 def env_name(path: str | Path) -> str:
     """A file-name-safe label for a user environment map (its stem)."""
     from radar_cli.dataset import safe_id

@@ -26,7 +26,7 @@ from radar_cli.derender.run.predictor import Predictor
 from radar_cli.derender.present.report import write_report
 from radar_cli.derender.run.shard import Shard, read_share_failures, write_share_failures
 from radar_cli.derender.run.upsample import full_resolution_state
-from radar_cli.errors import InputError, RadarError
+from radar_cli.errors import InputError, NothingToDoError, RadarError
 from radar_cli.fileio import remove_stale_temps
 from radar_cli.model.outputs import Decomposition
 from radar_cli.threads import torch_threads
@@ -35,6 +35,9 @@ T, R = TypeVar("T"), TypeVar("R")
 EXPORT_THREADS = 1  # exports work on small tensors: one torch thread ran them 2-5x faster than two (2 cores)
 # errors of one object's export that must not stop the batch (decoding, writing, a degenerate prediction)
 ITEM_ERRORS = (RadarError, OSError, ValueError, RuntimeError)
+SHARED_TEMP_AGE_S = 60.0
+"""A share of a collection removes only temporary files this old outside its own objects: the other shares
+writing into the same folder finish each of theirs in well under a second."""
 
 
 @dataclass(frozen=True)
@@ -67,6 +70,8 @@ class BatchSummary:
     failures: list[Failure] = field(default_factory=list)
     seconds: float = 0.0
     index: Path | None = None
+    printed: bool = True
+    """False on the torchrun ranks other than 0, whose summary line rank 0 prints with its own."""
 
     def line(self) -> str:
         rate = len(self.done) / self.seconds if self.seconds > 0 else 0.0
@@ -104,6 +109,21 @@ def _prepare_all(items: list[InputItem], size: int, options: DerenderOptions) ->
     return _thread_map(one, items, options.workers)
 
 
+def collect(inputs: list[str | Path], options: DerenderOptions) -> tuple[list[InputItem], list[Failure]]:
+    """The run's photos and the inputs that failed (see inputs.collect_inputs).
+
+    Raises InputError when --out is one of the input folders (the report would land among the photos) and
+    NothingToDoError when no input holds a photo; nothing is written in either case."""
+    out = options.out.resolve()
+    for raw in inputs:
+        if Path(raw).is_dir() and Path(raw).resolve() == out:
+            raise InputError(f"{options.out}: --out is the input folder {raw}; choose a results folder outside it")
+    items, failures = collect_inputs(list(inputs), options.masks, exclude=options.out)
+    if not items:
+        raise NothingToDoError("; ".join(f.line() for f in failures) or "no inputs given")
+    return items, failures
+
+
 def _pending(batch: list[InputItem], out: Path, overwrite: bool, summary: BatchSummary,
              say: Callable[[str], None]) -> set[str]:
     """The names of a batch still to do; finished folders are skipped unless `overwrite`."""
@@ -114,7 +134,7 @@ def _pending(batch: list[InputItem], out: Path, overwrite: bool, summary: BatchS
             say(f"{item.name}: skipped, {out / item.name} exists (use --overwrite to redo it)")
         else:
             todo.add(item.name)
-            remove_stale_temps(out / item.name)  # what a killed run was writing
+            remove_stale_temps(out / item.name)  # this share's own object: whatever a killed run was writing
     return todo
 
 
@@ -139,8 +159,10 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
     output_side(options.resolution, 1)  # checks it before any work
     render = predictor.setup.render
     envs = environments(options.envs, render.env_height, render.env_width)
-    items, failures = collect_inputs(list(inputs), options.masks, exclude=options.out)
+    items, failures = collect(inputs, options)
     shard = options.shard
+    if options.out.is_dir():  # what a killed run was writing: the report, the gallery, finished objects
+        remove_stale_temps(options.out, recursive=True, min_age_s=SHARED_TEMP_AGE_S if shard.enabled else 0.0)
     summary = BatchSummary(failures=list(failures) if shard.index == 0 else [])  # input errors: share 0 records
     for f in summary.failures:
         say(f.line())

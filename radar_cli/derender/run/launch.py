@@ -9,7 +9,7 @@ from typing import Callable
 
 from radar_cli import distributed
 from radar_cli.derender.present.report import write_report
-from radar_cli.derender.run.batch import BatchSummary, DerenderOptions, derender
+from radar_cli.derender.run.batch import BatchSummary, DerenderOptions, collect, derender
 from radar_cli.derender.run.predictor import Predictor
 from radar_cli.derender.run.shard import Shard, read_share_failures
 from radar_cli.errors import InputError
@@ -33,6 +33,7 @@ def derender_sharded(inputs: list[str | Path], load: Callable[[str], Predictor],
     Returns:
         This share's BatchSummary (its `index` set on the share that wrote the report).
     """
+    collect(inputs, options)  # a refused --out or inputs without a photo end the run before the model loads
     info = distributed.setup(device)
     try:
         if info.enabled and options.shard.enabled:
@@ -41,9 +42,30 @@ def derender_sharded(inputs: list[str | Path], load: Callable[[str], Predictor],
         options = dataclasses.replace(options, shard=shard)
         summary = derender(inputs, load(str(info.device)), options, say, report=not info.enabled)
         distributed.barrier(info)  # every share's folders and failure list are written
+        if info.enabled:
+            summary = _whole_run(summary, info)
         if info.enabled and info.is_main:
             summary.index = write_report(options.out, read_share_failures(options.out, shard.count))
         distributed.barrier(info)  # no rank exits (and has torchrun stop the others) before the report is done
         return summary
     finally:
         distributed.teardown(info)
+
+
+def _whole_run(summary: BatchSummary, info: distributed.DistInfo) -> BatchSummary:
+    """Under torchrun: on rank 0 the summary of every rank together (the one the command prints), on the other
+    ranks theirs with `printed` off."""
+    import torch.distributed as dist
+
+    shares: list[BatchSummary | None] = [None] * info.world
+    dist.all_gather_object(shares, summary)
+    if not info.is_main:
+        return dataclasses.replace(summary, printed=False)
+    whole = dataclasses.replace(summary, done=[], skipped=[], failures=[])
+    for share in shares:
+        assert share is not None
+        whole.done += share.done
+        whole.skipped += share.skipped
+        whole.failures += share.failures
+    whole.seconds = max(share.seconds for share in shares if share is not None)
+    return whole
