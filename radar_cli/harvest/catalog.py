@@ -295,3 +295,33 @@ def stored_size(text: str | None) -> ObjectSize | None:
         return ObjectSize.from_dict(json.loads(text)) if text else None
     except ValueError:
         return None
+
+
+PHOTO_COLUMNS = ("object_id", "title", "credit_line", "licence", "object_url", "size")
+CATALOG_DEPTH = 4  # a photo lies at most this many folders below its harvest folder (met/<id>/<id>_1.jpg: 2)
+
+
+def photo_row(photo: Path, catalogs: dict[Path, sqlite3.Connection]) -> dict[str, Any] | None:
+    """The catalog row (PHOTO_COLUMNS) of the object a harvested photo shows, its primary image or one of its
+    views, found through the catalog.sqlite of a folder above it (opened read-only once into `catalogs`, which
+    the caller closes); None when the photo is not in a harvest.
+
+    Raises:
+        sqlite3.Error, OSError: an unreadable catalog.
+    """
+    for data_dir in list(photo.parents)[:CATALOG_DEPTH]:
+        if not (data_dir / CATALOG_NAME).is_file():
+            continue
+        db = catalogs.get(data_dir)
+        if db is None:
+            db = catalogs[data_dir] = sqlite3.connect(f"file:{data_dir / CATALOG_NAME}?mode=ro", uri=True)
+        have = {r[1] for r in db.execute("PRAGMA table_info(objects)")}
+        columns = ", ".join(c if c in have else f"NULL AS {c}" for c in PHOTO_COLUMNS)
+        rel = photo.relative_to(data_dir).as_posix()
+        row = db.execute(f"SELECT {columns} FROM objects WHERE image_path = ?", (rel,)).fetchone()
+        has_views = db.execute("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'views'").fetchone()
+        if row is None and has_views:
+            row = db.execute(f"SELECT {columns} FROM objects WHERE object_id = "
+                             "(SELECT object_id FROM views WHERE image_path = ?)", (rel,)).fetchone()
+        return dict(zip(PHOTO_COLUMNS, row)) if row else None
+    return None
