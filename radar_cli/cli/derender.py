@@ -86,12 +86,17 @@ RESOLUTION = ResolutionType()
 @click.option("--shard", "shard", default="0/1", show_default=True, metavar="K/N",
               help="De-render only share K (0..N-1) of N, for batch schedulers; under torchrun each rank takes "
                    "its share by itself. Every share writes into the same --out.")
+@click.option("--dimensions", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Table of catalogued sizes (TSV or CSV: an object/id column, height_cm, optional rim_cm, "
+                   "body_cm, foot_cm): results named <id> or <id>_<view>, or photos in a folder <id>/, get meshes "
+                   "in metres at that height. Without it a harvested record's size is used where there is one.")
 @click.option("--contact-sheet", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Also write a contact sheet PNG (input, reconstruction, albedo, relit view per object).")
 def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks: Path | None, crop: str,
              backdrop: str, device: str, albedo: str, pitch: str, refine: str, reader: str, resolution: Resolution,
              views: int, view_size: int | None, envs: tuple[Path, ...], batch_size: int, workers: int,
-             threads: int, overwrite: bool, shard: str, contact_sheet: Path | None) -> None:
+             threads: int, overwrite: bool, shard: str, dimensions: Path | None,
+             contact_sheet: Path | None) -> None:
     """De-render INPUTS (image files, folders, prepared dataset folders) into --out.
 
     On many processes or machines: `torchrun --nnodes N --nproc_per_node P -m radar_cli derender ...` (rank 0
@@ -102,7 +107,8 @@ def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks
 
     options = DerenderOptions(out=out, crop=crop, backdrop=backdrop, masks=masks,  # type: ignore[arg-type]
                               envs=envs, batch_size=batch_size, workers=workers, threads=threads, overwrite=overwrite,
-                              export=ExportConfig(views, view_size), resolution=resolution, shard=Shard.parse(shard))
+                              export=ExportConfig(views, view_size), resolution=resolution, shard=Shard.parse(shard),
+                              dimensions=dimensions)
     summary = derender_sharded(list(inputs), load, options, device, say=lambda line: click.echo(line, err=True))
     if contact_sheet is not None and summary.index is not None and (summary.done or summary.skipped):
         click.echo(f"contact sheet: {write_contact_sheet(out, contact_sheet)}")

@@ -33,6 +33,9 @@ def _check_date(ctx: click.Context, param: click.Parameter, value: str | None) -
               help="Keep only public-domain (CC0) objects, or every object with an image.")
 @click.option("--image", type=click.Choice(["original", "small"]), default="original", show_default=True,
               help="Full-size primaryImage or ~600 px primaryImageSmall.")
+@click.option("--images", "images", type=click.Choice(["primary", "all"]), default="primary", show_default=True,
+              help="primary: one image per object (met/<id>.jpg); all: also the record's additionalImages, an "
+                   "object with several images in its own folder met/<id>/ (<id>_0.jpg is the primary).")
 @click.option("--api-url", default=DEFAULT_API_URL, show_default=True, help="API base URL.")
 @click.option("--rate", type=float, default=1.0, show_default=True,
               help="Requests per second, per host (API and image host are paced separately).")
@@ -47,17 +50,17 @@ def _check_date(ctx: click.Context, param: click.Parameter, value: str | None) -
 @click.option("--page-size", type=int, default=500, hidden=True, help="Search page size.")
 @click.option("--progress/--no-progress", default=True, help="Show progress bars.")
 def fetch(query: str, out: Path, limit: int | None, department: int | None, public_domain: bool, image: str,
-          api_url: str, rate: float, user_agent: str, since: str | None, ids_file: Path | None, timeout: float,
+          images: str, api_url: str, rate: float, user_agent: str, since: str | None, ids_file: Path | None, timeout: float,
           block_wait: float, result_cap: int, page_size: int, progress: bool) -> None:
     """Harvest a Met Collection API query into OUT: search, object records, then validated images.
 
-    Resumable: rerun the same command after a crash or Ctrl-C. Exits 1 when objects failed or the API could not
-    be reached (a run that harvested nothing leaves no folder behind).
+    Resumable: rerun the same command after a crash or Ctrl-C. Exits 1 when objects or views failed or the API
+    could not be reached (a run that harvested nothing leaves no folder behind).
     """
     api_client = ClientConfig(rate=rate, user_agent=user_agent, timeout=timeout, block_wait=block_wait)
     config = HarvestConfig(
         out=out, query=query, limit=limit, department=department, public_domain_only=public_domain,
-        image=image, api_url=api_url, since=since, ids_file=ids_file, page_size=page_size, result_cap=result_cap,
+        image=image, images=images, api_url=api_url, since=since, ids_file=ids_file, page_size=page_size, result_cap=result_cap,
         api_client=api_client, image_client=dataclasses.replace(api_client, max_bytes=50 * 1024 * 1024),
         progress=progress)  # type: ignore[arg-type]
     summary = harvest(config)
@@ -66,5 +69,5 @@ def fetch(query: str, out: Path, limit: int | None, department: int | None, publ
         click.echo(f"Error: {summary.aborted}", err=True)
     if summary.interrupted:
         sys.exit(130)
-    if summary.failed or summary.aborted:
+    if summary.failed or summary.views_failed or summary.aborted:
         sys.exit(1)

@@ -4,6 +4,8 @@ Layout of the output folder:
     DATA/catalog.sqlite        one row per object (see catalog.py)
     DATA/met/<id>.json         the object record exactly as the API sent it
     DATA/met/<id>.jpg          the validated image (name from the numeric id only)
+    DATA/met/<id>/<id>_<k>.jpg with --images all, an object with several images: the primary (k = 0) and its
+                               additionalImages (k = 1, 2, ...), see views.py
     DATA/failures.csv          object_id,error of the objects that failed (rewritten at the end of each run)
     DATA/.fetch.lock           held while a run writes the folder (one run per folder at a time), then removed
 """
@@ -26,8 +28,10 @@ from radar_cli.errors import InputError, NetworkError
 from radar_cli.fileio import remove_stale_temps, write_bytes, write_text
 from radar_cli.harvest.catalog import CATALOG_NAME, Catalog, open_catalog
 from radar_cli.harvest.client import BodyTooLarge, ClientConfig, FetchError, HttpClient
+from radar_cli.harvest.dimensions import size_of_record
 from radar_cli.harvest.images import MAX_PIXELS, ImageRejected, store_image
 from radar_cli.harvest.met_api import DEFAULT_API_URL, MetApi
+from radar_cli.harvest.views import ViewStage, read_stored_record
 
 OBJECTS_DIR = "met"
 LOCK_FILE = ".fetch.lock"
@@ -50,6 +54,8 @@ class HarvestConfig:
     """Keep only public-domain (CC0) objects; others are skipped with reason not_public_domain."""
     image: Literal["original", "small"] = "original"
     """primaryImage (up to 4000 px) or primaryImageSmall (~600 px)."""
+    images: Literal["primary", "all"] = "primary"
+    """`all`: also download additionalImages as views (DATA/met/<id>/ for objects with several images)."""
     api_url: str = DEFAULT_API_URL
     """API base URL (point it at a local server for offline runs)."""
     since: str | None = None
@@ -78,6 +84,9 @@ class Summary:
     records_fetched: int = 0
     images_fetched: int = 0
     images_unchanged: int = 0
+    views_fetched: int = 0
+    views_unchanged: int = 0
+    view_counts: dict[str, int] = field(default_factory=dict)
     counts: dict[str, int] = field(default_factory=dict)
     skipped: Counter[str] = field(default_factory=Counter)
     interrupted: bool = False
@@ -88,6 +97,11 @@ class Summary:
         """Objects in the failed state."""
         return self.counts.get("failed", 0)
 
+    @property
+    def views_failed(self) -> int:
+        """Additional views in the failed state."""
+        return self.view_counts.get("failed", 0)
+
     def line(self) -> str:
         """The one-line summary printed at the end of a run."""
         skipped = ", ".join(f"{k} {v}" for k, v in sorted(self.skipped.items())) or "none"
@@ -96,6 +110,10 @@ class Summary:
                 f"skipped {sum(self.skipped.values())} ({skipped}); failed {self.failed}")
         if self.counts.get("searched", 0) or self.counts.get("record", 0):
             text += f"; pending {self.counts.get('searched', 0) + self.counts.get('record', 0)}"
+        if self.view_counts:
+            text += (f"; views: fetched {self.views_fetched} ({self.views_unchanged} unchanged), have "
+                     f"{self.view_counts.get('image', 0)}, skipped {self.view_counts.get('skipped', 0)}, "
+                     f"failed {self.views_failed}, pending {self.view_counts.get('pending', 0)}")
         if self.interrupted:
             text += " [interrupted: rerun to resume]"
         if self.aborted:
@@ -174,6 +192,19 @@ class Harvester:
             for object_id in pending:
                 self._guard(self._image, object_id)
                 bar.update()
+
+    def views_stage(self) -> None:
+        """Stage 4 (`--images all`): the additional images of every object with a stored image."""
+        ViewStage(Path(self.config.out), OBJECTS_DIR, self.catalog, self.images, self.config.max_pixels,
+                  self.summary, self.config.progress, MAX_CONSECUTIVE_FAILURES).run()
+
+    def fill_sizes(self) -> None:
+        """Parse the size of stored records that have none yet (catalogs written before sizes were kept)."""
+        for row in self.catalog.rows():
+            if row["size"] is None and row["record_path"]:
+                record = read_stored_record(Path(self.config.out), row["record_path"])
+                if record is not None:
+                    self.catalog.set_size(row["object_id"], size_of_record(record))
 
     def _guard(self, step: Callable[[int], None], object_id: int) -> None:
         """Run one object's step; a network failure marks it failed, too many in a row stop the run."""
@@ -261,14 +292,16 @@ class Harvester:
 
 def _write_failures(catalog: Catalog, out: Path) -> None:
     rows = [r for r in catalog.rows() if r["state"] == "failed"]
+    views = [v for v in catalog.views() if v["state"] == "failed"]
     path = out / "failures.csv"
-    if not rows:
+    if not rows and not views:
         path.unlink(missing_ok=True)
         return
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(["object_id", "error"])
     writer.writerows([r["object_id"], r["reason"]] for r in rows)
+    writer.writerows([v["object_id"], f"view {v['view']}: {v['reason']}"] for v in views)
     write_text(path, buf.getvalue())
 
 
@@ -342,6 +375,9 @@ def _harvest(config: HarvestConfig, out: Path, log: Callable[[str], None], fresh
             harvester.search()
             harvester.records()
             harvester.images_stage()
+            harvester.fill_sizes()
+            if config.images == "all":
+                harvester.views_stage()
         except KeyboardInterrupt:
             summary.interrupted = True
         except NetworkError as e:
@@ -350,5 +386,6 @@ def _harvest(config: HarvestConfig, out: Path, log: Callable[[str], None], fresh
             summary.aborted = str(e)
         summary.counts = catalog.counts()
         summary.skipped = catalog.skip_reasons()
+        summary.view_counts = catalog.view_counts()
         _write_failures(catalog, out)
     return summary

@@ -67,15 +67,22 @@ def validate_image(body: bytes, max_pixels: int = MAX_PIXELS) -> str:
     return EXTENSIONS[fmt]
 
 
-def store_image(body: bytes, folder: Path, object_id: int, max_pixels: int = MAX_PIXELS) -> StoredImage:
-    """Validate an image and write it as `folder/<object_id><ext>` by atomic rename.
+def store_image(body: bytes, folder: Path, object_id: int, max_pixels: int = MAX_PIXELS,
+                view: int | None = None) -> StoredImage:
+    """Validate an image and write it as `folder/<object_id><ext>` (a view: `<object_id>_<view><ext>`) by
+    atomic rename.
 
-    The file name comes from the numeric object id only, never from the remote URL.
+    The file name comes from the numeric object id and view index only, never from the remote URL.
 
     Raises:
         ImageRejected: see `validate_image`.
     """
     ext = validate_image(body, max_pixels)
-    path = folder / f"{int(object_id)}{ext}"
+    path = folder / f"{image_stem(object_id, view)}{ext}"
     write_bytes(path, body)
     return StoredImage(path, len(body), hashlib.sha256(body).hexdigest())
+
+
+def image_stem(object_id: int, view: int | None = None) -> str:
+    """The file name (without extension) of an object's image or of one of its views (0 = the primary)."""
+    return f"{int(object_id)}" if view is None else f"{int(object_id)}_{int(view)}"

@@ -58,7 +58,8 @@ def catalog_sources(data_dir: Path) -> list[Source]:
 
     return [Source(f"met_{e.object_id}", e.image_path,
                    {"object_id": e.object_id, "title": e.title, "credit_line": e.credit_line,
-                    "licence": e.licence, "object_url": e.object_url})
+                    "licence": e.licence, "object_url": e.object_url,
+                    **({"size": e.size.to_dict()} if e.size is not None else {})})
             for e in iter_images(data_dir)]
 
 

@@ -43,6 +43,13 @@ def predictor() -> Predictor:
     return Predictor(FakeModel(), SETUP, "fake-model", "cpu")
 
 
+@pytest.fixture
+def fake_checkpoint(monkeypatch, predictor: Predictor) -> None:
+    """`radar derender` loads the tiny untrained `predictor` whatever --checkpoint says."""
+    monkeypatch.setattr(Predictor, "from_checkpoint",
+                        classmethod(lambda cls, path, device, albedo, pitch, refine="none", reader="bundled": predictor))
+
+
 def vase_photo(seed: int, shape: tuple[int, int] = (SIZE, SIZE)) -> np.ndarray:
     """H x W x 3 uint8: a dark ellipse on a light backdrop (so radar masks' detector finds it)."""
     rng = np.random.default_rng(seed)

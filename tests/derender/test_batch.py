@@ -108,12 +108,6 @@ def test_gallery_and_summary(results: Path) -> None:
     assert (results / "failures.csv").read_text().strip() == "source,problem"
 
 
-@pytest.fixture
-def fake_checkpoint(monkeypatch, predictor: Predictor) -> None:
-    monkeypatch.setattr(Predictor, "from_checkpoint",
-                        classmethod(lambda cls, path, device, albedo, pitch, refine="none", reader="bundled": predictor))
-
-
 def test_cli_bad_inputs_one_line_each(tmp_path: Path, fake_checkpoint) -> None:
     good = write_photo(tmp_path / "good.png", 3)
     corrupt = tmp_path / "corrupt.png"

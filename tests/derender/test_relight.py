@@ -76,7 +76,7 @@ def test_relight_bad_folder_and_env_one_line(obj: Path, tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("name", ["studio", "overcast", "sunset", "two_lights"])
 def test_relight_takes_the_builtin_environments_by_name(obj: Path, tmp_path: Path, name: str) -> None:
-    env = read_state(obj).env[0].numpy()
+    env = read_state(obj).material.env[0].numpy()
     np.save(tmp_path / "map.npy", builtin_environments(*env.shape)[name])
     runner = CliRunner()
     for spec, out in ((name, "by_name.png"), (str(tmp_path / "map.npy"), "by_file.png")):

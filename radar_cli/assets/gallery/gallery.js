@@ -6,6 +6,9 @@
 (function () {
   const DATA = window.RADAR_GALLERY || { objects: [], builtin_envs: [], failed: 0, scores: [] };
   const PAGE_SIZE = 120;
+  // objects of known size (meshes in metres) are all seen from this far, so their sizes compare on screen
+  const REAL_SIZE_DISTANCE = "2m";
+  const REAL_SIZE_FOV = "30deg";
   const STATUS_ORDER = { failed: 0, review: 1, unknown: 2, ok: 3 };
   const FROM_DISK = location.protocol === "file:";
   const byId = new Map(DATA.objects.map((o) => [o.id, o]));
@@ -220,7 +223,8 @@
       "shadow-intensity": "0",
       exposure: "1",
       "environment-image": envs.length ? envs[0][1] : null,
-      "camera-orbit": "0deg 80deg auto",
+      "camera-orbit": "0deg 80deg " + (o.size ? REAL_SIZE_DISTANCE : "auto"),
+      "field-of-view": o.size ? REAL_SIZE_FOV : null,
     });
     const buttons = el("div", { class: "envs" }, el("span", { text: "Lighting: " }));
     const skybox = el("input", { type: "checkbox" });
@@ -254,6 +258,15 @@
       box.append(el("p", { class: "note", text: "The viewer could not load the mesh of " + o.id + "." })),
     );
     box.append(mv, buttons, el("label", {}, skybox, " show the environment "), el("label", {}, " exposure ", exposure));
+    box.append(
+      el("p", {
+        class: "note",
+        text: o.size
+          ? `Real size: ${fmt(o.size.mesh_cm.height, 1)} cm high, seen from ${REAL_SIZE_DISTANCE} ` +
+            "(as every object of known size); drag to turn, scroll to come closer."
+          : "Size unknown: the mesh is unitless and framed to fit.",
+      }),
+    );
     loadScript(".gallery/model-viewer-umd.min.js").catch((e) =>
       box.append(el("p", { class: "note", text: e.message })),
     );
@@ -274,6 +287,12 @@
       ["specular albedo", fmt(m.rho, 2)],
       ["roughness (glTF)", fmt(m.roughness, 2)],
     );
+    if (o.size) {
+      const plain = ["height", "width", "diameter"];
+      for (const [k, v] of Object.entries(o.size.cm))
+        rows.push([plain.includes(k) ? k : k + " diameter", fmt(v, 1) + " cm"]);
+      rows.push(["size from", o.size.source], ["mesh widest", fmt(o.size.mesh_cm.max_diameter, 1) + " cm"]);
+    }
     const table = el(
       "table",
       { class: "values" },

@@ -1,6 +1,7 @@
 """Textured meshes of one object: mesh.glb (PBR material: 360 deg albedo, roughness from the shininess) and
 mesh.obj + .mtl + texture, via trimesh: axis = +y, the photographed side facing +z (the glTF/OBJ viewers' default
-front), i.e. the canonical object frame turned 180 deg about the axis."""
+front), i.e. the canonical object frame turned 180 deg about the axis. In the model's units, or in metres (glTF's
+unit) with the object's catalogued height when its size is known."""
 
 from __future__ import annotations
 
@@ -39,9 +40,26 @@ def build_mesh(state: ObjectState, n_cols: int) -> trimesh.Trimesh:
     return trimesh.Trimesh(vertices, sor.faces.numpy(), visual=visual, process=False)
 
 
-def write_meshes(folder: Path, state: ObjectState, n_cols: int) -> None:
-    """mesh.glb, and mesh.obj with its material.mtl and texture PNG, written atomically."""
+def to_real_size(mesh: trimesh.Trimesh, height_cm: float) -> dict[str, float]:
+    """Scale a mesh (axis +y) about its origin so that its height is `height_cm`, in metres.
+
+    Returns:
+        The scaled mesh's `height` and widest `max_diameter` about the axis, in cm.
+    """
+    mesh.apply_scale(height_cm / 100.0 / float(np.ptp(mesh.vertices[:, 1])))
+    radial = float(np.hypot(mesh.vertices[:, 0], mesh.vertices[:, 2]).max())
+    return {"height": round(float(np.ptp(mesh.vertices[:, 1])) * 100.0, 3), "max_diameter": round(200.0 * radial, 3)}
+
+
+def write_meshes(folder: Path, state: ObjectState, n_cols: int, height_cm: float | None = None) -> dict | None:
+    """mesh.glb, and mesh.obj with its material.mtl and texture PNG, written atomically; in metres when the
+    object's `height_cm` is given.
+
+    Returns:
+        The meshes' height and widest diameter in cm (to_real_size), or None when unitless.
+    """
     mesh = build_mesh(state, n_cols)
+    real = to_real_size(mesh, height_cm) if height_cm is not None else None
     write_bytes(folder / MESH_GLB_FILE, mesh.export(file_type="glb"))
     obj_mesh = mesh.copy()
     # OBJ/MTL is Phong: white Kd so viewers show the texture as is, Ns = shininess, Ks from the specular albedo
@@ -56,4 +74,5 @@ def write_meshes(folder: Path, state: ObjectState, n_cols: int) -> None:
             raise OSError(f"unexpected texture file name from the OBJ exporter: {name!r}")
         write_bytes(folder / name, data)
     write_bytes(folder / MESH_OBJ_FILE, text.encode("utf-8"))
+    return real
 

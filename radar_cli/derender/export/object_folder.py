@@ -17,6 +17,7 @@ from radar_cli.derender.export.renders import write_renders
 from radar_cli.derender.run.state import ObjectState
 from radar_cli.fileio import write_json
 from radar_cli.results import APPENDAGES_FILE, INPUT_FILE, MATERIAL_FILE, SILHOUETTE_FILE
+from radar_cli.sizes import ObjectSize
 
 
 MIN_VIEW_SIZE = 128
@@ -45,7 +46,7 @@ def is_complete(folder: Path) -> bool:
 def export_object(folder: Path, item: InputItem, prepared: Prepared, state: ObjectState, setup: ModelSetup,
                   version: str, envs: dict[str, np.ndarray], config: ExportConfig = ExportConfig(),
                   albedo_source: AlbedoSource = "network", pitch_source: PitchSource = "network",
-                  refine: dict | None = None) -> dict:
+                  refine: dict | None = None, size: ObjectSize | None = None) -> dict:
     """Write all files of one object; image-space outputs at the output side N = prepared.side.
 
     Args:
@@ -59,6 +60,8 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         albedo_source: where the albedo came from (`network` or `divided`, see Predictor).
         pitch_source: where the pitch came from (`network` or `search`, see Predictor).
         refine: what the per-object refinement did (derender.refine.driver.RefineReport.record()), if it ran.
+        size: the object's catalogued size, if known (meshes in metres at its height); one without a height
+            leaves them unitless and says why in material.json.
 
     Returns:
         The material.json record.
@@ -72,7 +75,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
     if prepared.appendages is not None and prepared.appendages.any():  # written only where something was left out
         write_picture(folder / APPENDAGES_FILE, prepared.appendages.astype(np.uint8) * 255)
     write_maps(folder, state, setup.render)
-    write_meshes(folder, state, setup.geometry.n_cols)
+    real = write_meshes(folder, state, setup.geometry.n_cols, size.height_cm if size and size.known else None)
     drawn, recon = write_renders(folder, state, side, config.view_side(side), config.views, envs)
     record = state.record()
     record.update({
@@ -89,6 +92,19 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         **({"refine": refine} if refine is not None else {}),
         "environments": sorted(envs),
         "quality": assess_drawn(prepared, drawn, recon),
+        **size_record(size, real),
     })
     write_json(folder / MATERIAL_FILE, record)
     return record
+
+
+def size_record(size: ObjectSize | None, mesh_cm: dict | None) -> dict:
+    """material.json's size keys: `size_cm` (the catalogue's lengths), `size_source`, `mesh_unit` and `mesh_cm`
+    (the meshes' height and widest diameter) when the meshes are in metres; `size_note` when a size was looked
+    for but not usable; nothing when no size is known."""
+    if size is None:
+        return {}
+    if mesh_cm is None:
+        return {"size_source": size.source, "size_note": f"{size.status}: {size.note}".rstrip(": ")}
+    record = {"size_cm": size.lengths(), "size_source": size.source, "mesh_unit": "m", "mesh_cm": mesh_cm}
+    return {**record, "size_note": size.note} if size.note else record

@@ -109,7 +109,7 @@ def attribution(source: str, catalogs: dict[Path, sqlite3.Connection]) -> dict |
     """Title, credit line, licence and catalogue link of an input that came from `radar masks` (its meta.json)
     or straight from a `radar fetch` folder (its catalog.sqlite, opened read-only once into `catalogs`), else
     None."""
-    from radar_cli.harvest.catalog import CATALOG_NAME
+    from radar_cli.harvest.catalog import photo_row
 
     path = Path(source)
     meta = path.parent / "meta.json"
@@ -118,18 +118,7 @@ def attribution(source: str, catalogs: dict[Path, sqlite3.Connection]) -> dict |
         if meta.is_file() and meta.stat().st_size <= MAX_META_BYTES:
             found = json.loads(meta.read_text("utf-8")).get("attribution") or None
         else:
-            for data_dir in list(path.parents)[:4]:
-                if (data_dir / CATALOG_NAME).is_file():
-                    db = catalogs.get(data_dir)
-                    if db is None:
-                        db = catalogs[data_dir] = sqlite3.connect(f"file:{data_dir / CATALOG_NAME}?mode=ro", uri=True)
-                    row = db.execute(
-                        "SELECT object_id, title, credit_line, licence, object_url FROM objects "
-                        "WHERE image_path = ?",
-                        (str(path.relative_to(data_dir)),)).fetchone()
-                    keys = ("object_id", "title", "credit_line", "licence", "object_url")
-                    found = dict(zip(keys, row)) if row else None
-                    break
+            found = photo_row(path, catalogs)
     except (OSError, ValueError, AttributeError, sqlite3.Error):
         return None
     if not isinstance(found, dict):
@@ -141,6 +130,15 @@ def attribution(source: str, catalogs: dict[Path, sqlite3.Connection]) -> dict |
 
 def _number(value: object) -> float | None:
     return float(value) if isinstance(value, (int, float)) and math.isfinite(value) else None
+
+
+def real_size(rec: dict) -> dict | None:
+    """The catalogued lengths (cm), their source and the mesh's measured ones, when the mesh is in metres."""
+    lengths, mesh = rec.get("size_cm"), rec.get("mesh_cm")
+    if rec.get("mesh_unit") != "m" or not isinstance(lengths, dict) or not isinstance(mesh, dict):
+        return None
+    return {"cm": {str(k): _number(v) for k, v in lengths.items()}, "source": str(rec.get("size_source") or ""),
+            "mesh_cm": {str(k): _number(v) for k, v in mesh.items()}}
 
 
 def object_entry(folder: Path, rec: dict, catalogs: dict[Path, sqlite3.Connection]) -> dict:
@@ -155,6 +153,7 @@ def object_entry(folder: Path, rec: dict, catalogs: dict[Path, sqlite3.Connectio
         "scores": {k: _number(quality.get(k)) for k in SCORE_KEYS if k in quality},
         "material": {k: _number(rec.get(k)) for k in ("pitch", "roll", "alpha", "rho", "roughness", "height")},
         "attribution": attribution(str(rec.get("source", "")), catalogs),
+        "size": real_size(rec),
         "relit": relit,
         "appendages": (folder / APPENDAGES_FILE).is_file(),
         "thumbnail": (folder / THUMBNAIL_FILE).is_file(),

@@ -22,6 +22,7 @@ from radar_cli.derender.export.environments import builtin_environments, env_nam
 from radar_cli.derender.export.object_folder import ExportConfig, export_object, is_complete
 from radar_cli.derender.run.inputs import (DEFAULT_RESOLUTION, Backdrop, CropMode, Failure, InputItem, Prepared,
                                        Resolution, collect_inputs, output_side, prepare)
+from radar_cli.derender.run.object_size import SizeFinder
 from radar_cli.derender.run.predictor import Predictor
 from radar_cli.derender.present.report import write_report
 from radar_cli.derender.run.shard import Shard, read_share_failures, write_share_failures
@@ -59,6 +60,8 @@ class DerenderOptions:
     """Side of the outputs (inputs.output_side): an integer, or `photo` for each crop's own size."""
     shard: Shard = Shard()
     """The share of the inputs this process de-renders (0/1: all of them)."""
+    dimensions: Path | None = None
+    """A table of catalogued sizes (radar_cli.sizes.read_size_table); harvested sizes are used without it."""
 
 
 @dataclass
@@ -159,6 +162,7 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
     output_side(options.resolution, 1)  # checks it before any work
     render = predictor.setup.render
     envs = environments(options.envs, render.env_height, render.env_width)
+    sizes = SizeFinder(options.dimensions)  # a bad table stops the run before any work
     items, failures = collect(inputs, options)
     shard = options.shard
     if options.out.is_dir():  # what a killed run was writing: the report, the gallery, finished objects
@@ -168,12 +172,12 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
         say(f.line())
     options.out.mkdir(parents=True, exist_ok=True)
     batches = shard.blocks(items, options.batch_size)
-    with torch_threads(options.threads), tqdm(total=sum(map(len, batches)), desc="derender", unit="obj",
-                                              disable=None) as bar:
+    with sizes, torch_threads(options.threads), tqdm(total=sum(map(len, batches)), desc="derender", unit="obj",
+                                                     disable=None) as bar:
         for batch in batches:
             todo = _pending(batch, options.out, options.overwrite, summary, say)
             if todo:
-                _run_batch(batch, todo, predictor, options, envs, summary, say)
+                _run_batch(batch, todo, predictor, options, envs, summary, say, sizes)
             bar.update(len(batch))
     if shard.enabled:
         write_share_failures(options.out, shard, summary.failures)
@@ -185,7 +189,8 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
 
 
 def _run_batch(chunk: list[InputItem], todo: set[str], predictor: Predictor, options: DerenderOptions,
-               envs: dict[str, np.ndarray], summary: BatchSummary, say: Callable[[str], None]) -> None:
+               envs: dict[str, np.ndarray], summary: BatchSummary, say: Callable[[str], None],
+               sizes: SizeFinder) -> None:
     """Crop and predict one whole batch and export its objects named in `todo`; failures are recorded item by
     item (a finished object is predicted again only so that its neighbours see the same batch)."""
     prepared = _prepare_all(chunk, predictor.setup.image_size, options)
@@ -202,15 +207,18 @@ def _run_batch(chunk: list[InputItem], todo: set[str], predictor: Predictor, opt
         return
     dec = predictor.predict([prep.image for _, prep in ok], [prep.silhouette for _, prep in ok])
     with torch_threads(EXPORT_THREADS):
-        _export_all(ok, todo, dec, predictor, options, envs, summary, say)
+        _export_all(ok, todo, dec, predictor, options, envs, summary, say, sizes)
 
 
 def _export_all(ok: list[tuple[InputItem, Prepared]], todo: set[str], dec: Decomposition, predictor: Predictor,
                 options: DerenderOptions, envs: dict[str, np.ndarray], summary: BatchSummary,
-                say: Callable[[str], None]) -> None:
+                say: Callable[[str], None], sizes: SizeFinder) -> None:
     """Export each predicted object named in `todo`, options.workers at a time (threads: PNG and zlib encoding
     and torch's operations release the GIL, and each object writes its own folder); an error costs that object
-    only."""
+    only. Sizes are looked up here, in the calling thread (it holds the catalogs' connections)."""
+    ks = [k for k, (item, _) in enumerate(ok) if item.name in todo]
+    found = {k: sizes.find(ok[k][0]) for k in ks}
+
     def one(k: int) -> Failure | None:
         # OpenMP's thread count is per thread: a pool thread would otherwise spin up every core, and sum in
         # another order than a one-worker run (different bytes)
@@ -223,12 +231,11 @@ def _export_all(ok: list[tuple[InputItem, Prepared]], todo: set[str], dec: Decom
                 say(f"{item.image_path}: refinement fell back to the network's prediction: {report.reason}")
             state = full_resolution_state(refined, prep, predictor.setup, predictor.albedo)
             export_object(options.out / item.name, item, prep, state, predictor.setup, predictor.version, envs,
-                          options.export, predictor.albedo, predictor.pitch, report.record())
+                          options.export, predictor.albedo, predictor.pitch, report.record(), found[k])
         except ITEM_ERRORS as e:
             return Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
         return None
 
-    ks = [k for k, (item, _) in enumerate(ok) if item.name in todo]
     # recorded in input order, whatever finished first
     for k, failure in zip(ks, _thread_map(one, ks, options.workers)):
         item = ok[k][0]
