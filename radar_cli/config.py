@@ -157,16 +157,60 @@ def to_dict(obj: Any) -> dict[str, Any]:
     return plain(dataclasses.asdict(obj))
 
 
-def load_toml(cls: type[T], path: str | Path) -> T:
-    """Load dataclass `cls` from a TOML file, strictly."""
-    path = Path(path)
+BASE_KEY = "base"
+"""Top-level key of a preset naming the preset it builds on, relative to the preset's own folder."""
+
+
+def _read_table(path: Path) -> dict[str, Any]:
+    """One TOML file as a dict; ConfigError naming the file when it is missing or malformed."""
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        return tomllib.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise ConfigError(f"{path}: no such config file") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
         raise ConfigError(f"{path}: not valid TOML ({e})") from None
+
+
+def deep_merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
+    """`base` with `over`'s values on top: tables merge key by key, any other value (lists too) replaces."""
+    merged = dict(base)
+    for key, value in over.items():
+        if isinstance(value, dict) and isinstance(merged.get(key), dict):
+            merged[key] = deep_merge(merged[key], value)
+        else:
+            merged[key] = value
+    return merged
+
+
+def _resolve(cls: type, path: Path, chain: tuple[Path, ...]) -> dict[str, Any]:
+    """The dict of `path` merged over its `base` chain; each file is checked against `cls` on its own first."""
+    data = _read_table(path)
+    base = data.pop(BASE_KEY, None)
+    from_dict(cls, data, where=str(path))  # unknown keys and wrong types, named in the file that holds them
+    if base is None:
+        return data
+    if not isinstance(base, str):
+        raise ConfigError(f"{path}.{BASE_KEY}: expected a file name, got {base!r}")
+    base_path = (path.parent / base).resolve()
+    if not base_path.is_file():
+        raise ConfigError(f"{path}.{BASE_KEY}: no such config file {base_path}")
+    if base_path in chain:
+        loop = " -> ".join(str(p) for p in (*chain, base_path))
+        raise ConfigError(f"{path}: base presets form a cycle ({loop})")
+    return deep_merge(_resolve(cls, base_path, (*chain, base_path)), data)
+
+
+def load_toml(cls: type[T], path: str | Path) -> T:
+    """Load dataclass `cls` from a TOML file, strictly.
+
+    A top-level `base = "other.toml"` (relative to the file's folder) loads that file first and lays this one's
+    values over it (tables merged key by key); bases may have bases of their own, a cycle is an error. Every file
+    in the chain is held to `cls`'s keys and types.
+    """
+    path = Path(path)
+    data = _resolve(cls, path, (path.resolve(),))
     return from_dict(cls, data, where=str(path))
 
 
-__all__ = ["CameraConfig", "GeometryConfig", "RenderConfig", "from_dict", "to_dict", "load_toml", "field"]
+__all__ = ["CameraConfig", "GeometryConfig", "RenderConfig", "from_dict", "to_dict", "load_toml", "deep_merge",
+           "field"]

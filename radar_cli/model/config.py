@@ -1,7 +1,8 @@
 """Typed configuration of a training run: the model (architecture, sizes, output ranges), the losses and the loop.
 
-One root `RunConfig` is loaded strictly from a `pipelines/**/*.toml` file and stored inside every checkpoint, so
-inference needs only the checkpoint. Defaults are the paper's (supplementary Table 4).
+One root `RunConfig` is loaded strictly from a `pipelines/**/*.toml` file (merged over the presets it names as
+`base`) and stored, resolved, inside every checkpoint, so inference needs only the checkpoint. Defaults are the
+paper's (supplementary Table 4): a preset holds only what differs from them.
 """
 
 from __future__ import annotations
@@ -163,7 +164,8 @@ class RunConfig:
 
 
 def load_run_config(path: str | Path) -> RunConfig:
-    """Load and validate a pipelines/**/*.toml file (unknown keys and wrong types raise ConfigError)."""
+    """Load and validate a pipelines/**/*.toml file and its `base` chain (unknown keys and wrong types raise
+    ConfigError naming the file that holds them)."""
     return load_toml(RunConfig, path).validate()
 
 
