@@ -20,7 +20,7 @@ ALBEDO ?= network
 # PITCH=search scores `radar derender --pitch search` (the test-time pitch search) instead of f_S's pitch
 PITCH ?= network
 
-.PHONY: install demo test test-all test-gpu test-browser clean \
+.PHONY: install demo test test-slow test-all test-gpu test-browser lint clean \
         syn-data syn-data-cpu syn-data-cpu-format1 train-syn train-syn-cpu eval-syn eval-syn-cpu table2 table2-cpu \
         met-fetch met-masks train-met real-vases bench specular-reader
 
@@ -29,7 +29,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/pip install -q --upgrade pip
 	# torch is pinned to the CPU build on disk; installing it first keeps pip from pulling CUDA wheels.
 	$(BIN)/pip install -q torch==2.13.0
-	$(BIN)/pip install -q -e '.[test]'
+	$(BIN)/pip install -q -e '.[test,lint]'
 	touch $(STAMP)
 
 install: $(STAMP)
@@ -38,11 +38,22 @@ install: $(STAMP)
 demo: $(STAMP)
 	$(RADAR) derender examples --out demo_out
 
+# The everyday suite, CPU only; tests marked slow (torchrun, subprocesses, shards, kill/resume, long optimisations)
+# are left to test-slow
 test: $(STAMP)
 	$(BIN)/python -m pytest -q -m "not slow and not gpu" tests
 
+test-slow: $(STAMP)
+	$(BIN)/python -m pytest -q -m "slow and not gpu" tests
+
+# Everything: test and test-slow, and the GPU tests, which skip without CUDA
 test-all: $(STAMP)
 	$(BIN)/python -m pytest -q tests
+
+# ruff on the package and the tests; mypy on the files pyproject.toml's [tool.mypy] names
+lint: $(STAMP)
+	$(BIN)/ruff check radar_cli tests
+	$(BIN)/mypy
 
 # CPU-vs-CUDA agreement of the renderer, the losses and the bundled model (each test skips without CUDA)
 test-gpu: $(STAMP)

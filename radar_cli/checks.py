@@ -1,4 +1,5 @@
-"""Argument checks for public tensor functions: shapes, dtypes and finite values, with messages that name the argument."""
+"""Argument checks for public tensor functions: shapes, dtypes and finite values, with messages that name the
+argument."""
 
 from __future__ import annotations
 

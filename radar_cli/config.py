@@ -82,7 +82,7 @@ class RenderConfig:
 def _convert(value: Any, tp: Any, where: str) -> Any:
     """Convert a TOML value to the annotated type, raising ConfigError on mismatch."""
     origin = get_origin(tp)
-    if dataclasses.is_dataclass(tp):
+    if isinstance(tp, type) and dataclasses.is_dataclass(tp):
         if not isinstance(value, dict):
             raise ConfigError(f"{where}: expected a table, got {type(value).__name__}")
         return from_dict(tp, value, where)

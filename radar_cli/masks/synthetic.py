@@ -192,7 +192,8 @@ def non_sor_mask(kind: str, size: int, rng: np.random.Generator) -> np.ndarray:
         for sgn in (-1, 1):
             ang = math.radians(u(20, 160))
             start = (c + sgn * int(s * 0.09), int(s * 0.35))
-            end = (start[0] + sgn * int(s * 0.2 * abs(math.cos(ang))), start[1] + int(s * 0.2 * math.sin(ang) - 0.1 * s))
+            end = (start[0] + sgn * int(s * 0.2 * abs(math.cos(ang))),
+                   start[1] + int(s * 0.2 * math.sin(ang) - 0.1 * s))
             cv2.line(m, start, end, 1, max(3, s // 30))
             cv2.line(m, (c + sgn * int(s * 0.05), int(s * 0.6)),
                      (c + sgn * int(s * u(0.03, 0.15)), int(s * 0.85)), 1, max(4, s // 22))

@@ -131,7 +131,7 @@ def sample_patches(albedo_tm: torch.Tensor, specular: torch.Tensor, patch: int, 
 
 def _frozen(disc: nn.Module) -> dict[str, torch.Tensor]:
     """D's parameters and buffers detached, so a loss through them never reaches D."""
-    state = dict(disc.named_parameters())
+    state: dict[str, torch.Tensor] = dict(disc.named_parameters())
     state.update(dict(disc.named_buffers()))
     return {k: v.detach() for k, v in state.items()}
 

@@ -43,9 +43,11 @@ class SpecularReader(nn.Module):
         reader.encoder.load_state_dict(light_net.encoder.state_dict())
         source = light_net.material_head
         reader.head[0].load_state_dict(source[0].state_dict())
+        out, source_out = reader.head[2], source[2]
+        assert isinstance(out, nn.Linear) and isinstance(source_out, nn.Linear)
         with torch.no_grad():
-            reader.head[2].weight.copy_(source[2].weight[1:2])
-            reader.head[2].bias.copy_(source[2].bias[1:2])
+            out.weight.copy_(source_out.weight[1:2])
+            out.bias.copy_(source_out.bias[1:2])
         return reader
 
     def forward(self, image: torch.Tensor, solid: Solid) -> torch.Tensor:

@@ -53,7 +53,8 @@ def random_inputs(batch: int, size: int, render: RenderConfig, device: torch.dev
     inputs = {
         "radius": radius,
         "height": 0.5 + 0.45 * torch.rand(batch, generator=g),
-        "pose": torch.rand(batch, 4, generator=g) * torch.tensor([20.0, 20.0, 0.4, 0.4]) - torch.tensor([0, 10, 0.2, 0.2]),
+        "pose": (torch.rand(batch, 4, generator=g) * torch.tensor([20.0, 20.0, 0.4, 0.4])
+                 - torch.tensor([0, 10, 0.2, 0.2])),
         "albedo": torch.rand(batch, 3, *tex, generator=g),
         "env": torch.rand(batch, render.env_height, render.env_width, generator=g),
         "alpha": 1 + 195 * torch.rand(batch, generator=g),

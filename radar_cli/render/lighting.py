@@ -143,9 +143,9 @@ class _Phong(torch.autograd.Function):
             lobe_sum.append((lobe @ rad)[..., 0])
             ctx.chunks.append(chunk)
         norm = (alpha[:, None] + 1) / (2 * math.pi)
-        lobe_sum = torch.cat(lobe_sum, 1)  # B x N, kept: d I_s / d alpha needs it
-        ctx.save_for_backward(n, p, radiance, alpha, dirs, lobe_sum)
-        return torch.cat(diffuse, 1), norm * lobe_sum
+        lobes = torch.cat(lobe_sum, 1)  # B x N, kept: d I_s / d alpha needs it
+        ctx.save_for_backward(n, p, radiance, alpha, dirs, lobes)
+        return torch.cat(diffuse, 1), norm * lobes
 
     @staticmethod
     def backward(ctx, g_diffuse, g_specular):

@@ -45,7 +45,7 @@ class Shading:
     def normals(self) -> torch.Tensor:
         """B x 3 x Ht x Wt camera-space unit normals at the texels, upsampled from the shading grid on first use
         (synthesis never reads them)."""
-        normals = upsample(self.grid_normals.permute(0, 3, 1, 2), tuple(self.texture.shape[-2:]))
+        normals = upsample(self.grid_normals.permute(0, 3, 1, 2), (self.texture.shape[-2], self.texture.shape[-1]))
         return normals / normals.norm(dim=1, keepdim=True).clamp_min(1e-6)
 
 

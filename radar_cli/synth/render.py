@@ -1,8 +1,8 @@
 """Render one synthetic vase and all its ground-truth maps with the project's renderer (forward only).
 
 The image is the whole object: the full 360 deg albedo shaded over the full span, drawn with its inside dimmed
-by RenderConfig.inside_dim, over a plain background (every pixel off the hard mask is the background). Ground-truth maps are drawn through the same ray-casting
-result so they line up with the image pixel for pixel.
+by RenderConfig.inside_dim, over a plain background (every pixel off the hard mask is the background). Ground-truth
+maps are drawn through the same ray-casting result so they line up with the image pixel for pixel.
 """
 
 from __future__ import annotations

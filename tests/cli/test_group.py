@@ -37,7 +37,8 @@ def test_every_registered_command_loads_and_has_help():
 
 
 def test_help_does_not_import_torch():
-    code = "import sys; from radar_cli.cli import cli; cli(['--help'], standalone_mode=False); print('torch' in sys.modules)"
+    code = ("import sys; from radar_cli.cli import cli; cli(['--help'], standalone_mode=False); "
+            "print('torch' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip().endswith("False")
 

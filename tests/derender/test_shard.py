@@ -59,6 +59,7 @@ def test_parse_and_blocks() -> None:
     assert sorted(i for s in shares for b in s for i in b) == items
 
 
+@pytest.mark.slow
 def test_shares_together_equal_one_process(photos: Path, tmp_path: Path) -> None:
     """Two --shard runs into one folder: every input once, one merged report, the same bytes per object."""
     predictor = Predictor(FakeModel(), SETUP, "fake-model", "cpu")
@@ -75,6 +76,7 @@ def test_shares_together_equal_one_process(photos: Path, tmp_path: Path) -> None
     assert len(failures) == 2 and "notes.txt" in failures[1]  # the input error once, though both shares saw it
 
 
+@pytest.mark.slow
 def test_rerun_redoes_a_half_written_object_to_the_same_bytes(photos: Path, tmp_path: Path) -> None:
     """What a killed process leaves (no material.json, a temporary file mid-rename) is redone and cleaned."""
     predictor = Predictor(FakeModel(), SETUP, "fake-model", "cpu")
@@ -115,6 +117,7 @@ def single_run(photos: Path, tmp_path_factory) -> Path:
     return out
 
 
+@pytest.mark.slow
 def test_torchrun_two_gloo_ranks_match_one_process(photos: Path, single_run: Path, tmp_path: Path) -> None:
     out = tmp_path / "out"
     done = subprocess.run(_derender_cmd(photos, out, 2), env=_env(), capture_output=True, text=True, timeout=300)
@@ -144,6 +147,7 @@ def _worker_pid(parent: int, rank: str) -> int | None:
 
 
 @pytest.mark.skipif(not Path("/proc/self/environ").is_file(), reason="finds torchrun's workers through /proc")
+@pytest.mark.slow
 def test_a_killed_rank_is_finished_by_rerunning(photos: Path, single_run: Path, tmp_path: Path) -> None:
     out = tmp_path / "out"
     agent = subprocess.Popen(_derender_cmd(photos, out, 2), env=_env(), stdout=subprocess.PIPE,
@@ -167,6 +171,7 @@ def test_a_killed_rank_is_finished_by_rerunning(photos: Path, single_run: Path, 
     assert object_files(out) == object_files(single_run)
 
 
+@pytest.mark.slow
 def test_torchrun_refuses_a_shard_option(photos: Path, tmp_path: Path) -> None:
     cmd = _derender_cmd(photos, tmp_path / "out", 2) + ["--shard", "0/2"]
     done = subprocess.run(cmd, env=_env(), capture_output=True, text=True, timeout=300)

@@ -5,6 +5,7 @@ the sharp setting of pipelines/bundled/stage2_sharp.toml (sigma 0.25 px, 1 px ma
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import torch
 
 from radar_cli.model.losses import distance_transform, silhouette_loss
@@ -35,6 +36,7 @@ def argmin_pitch_errors(sigma_px: float, margin_px: float, n: int = 12) -> np.nd
     return np.asarray(errors)
 
 
+@pytest.mark.slow
 def test_sharp_silhouette_removes_most_of_the_pitch_bias():
     paper = argmin_pitch_errors(1.0, 0.0)
     sharp = argmin_pitch_errors(0.25, 1.0)

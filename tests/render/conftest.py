@@ -21,7 +21,8 @@ def sine_profiles(n: int, generator: torch.Generator, dtype=torch.float64) -> to
     i = torch.arange(L_ROWS, dtype=dtype)[None]
     t, a1, p1, q1 = u(0.1, 0.3), u(0.0, 0.3), u(-math.pi, 0.0), u(math.pi / 2, 2 * math.pi)
     a2, p2, q2 = u(0.0, 0.1), u(0.0, 2 * math.pi), u(math.pi / 2, 2 * math.pi)
-    r = t + a1 * (1 + torch.sin((L_ROWS - i) / L_ROWS * p1 + i / L_ROWS * q1)) + a2 * (1 + torch.sin(p2 + i / L_ROWS * q2))
+    r = (t + a1 * (1 + torch.sin((L_ROWS - i) / L_ROWS * p1 + i / L_ROWS * q1))
+         + a2 * (1 + torch.sin(p2 + i / L_ROWS * q2)))
     lo, hi = GeometryConfig().radius_range
     return r.clamp(lo, hi)
 

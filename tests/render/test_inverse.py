@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pytest
 import torch
 
 from radar_cli.config import GeometryConfig
@@ -17,6 +18,7 @@ def iou(a: torch.Tensor, b: torch.Tensor) -> float:
     return float((a & b).sum() / (a | b).sum())
 
 
+@pytest.mark.slow
 def test_silhouette_fit_recovers_shape_and_pose(random_sor):
     geo = GeometryConfig()
     radius, height, pose = random_sor(1, seed=11, dtype=torch.float32)

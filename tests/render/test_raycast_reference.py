@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import torch
 import trimesh
 
@@ -35,6 +36,7 @@ def reference_hits(radius, height, pose, camera):
     return mask, depth
 
 
+@pytest.mark.slow
 def test_silhouette_and_depth_match_trimesh(random_sor):
     camera = CameraConfig()
     radius, height, pose = random_sor(N_SHAPES, seed=1)

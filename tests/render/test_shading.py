@@ -50,7 +50,8 @@ def test_specular_peak_matches_normalised_phong():
     view = view / view.norm()
     half = (light + view) / (light + view).norm()  # mirror direction: R = P exactly at this normal
     tilt = torch.tensor([0.0, 1.0, 0.0])
-    tilted = half * math.cos(0.05) + torch.linalg.cross(half, tilt) / torch.linalg.cross(half, tilt).norm() * math.sin(0.05)
+    axis = torch.linalg.cross(half, tilt)
+    tilted = half * math.cos(0.05) + axis / axis.norm() * math.sin(0.05)
     normals = torch.stack([half, tilted])[None, None]  # 1 x 1 x 2 x 3
     views = view.expand(1, 1, 2, 3)
     for alpha in (1.0, 20.0, 150.0):

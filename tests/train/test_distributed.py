@@ -9,6 +9,7 @@ import sys
 import textwrap
 from pathlib import Path
 
+import pytest
 import torch
 from safetensors.torch import load_file
 
@@ -63,6 +64,7 @@ def _torchrun(vases32, run: Path, mode: str) -> None:
     assert done.returncode == 0, done.stderr[-3000:]
 
 
+@pytest.mark.slow
 def test_ddp_two_gloo_processes_end_with_identical_weights(vases32, tmp_path):
     run = tmp_path / "run"
     _torchrun(vases32, run, "full")
@@ -75,6 +77,7 @@ def test_ddp_two_gloo_processes_end_with_identical_weights(vases32, tmp_path):
     assert len(list((run / "checkpoints").iterdir())) == 2  # only rank 0 writes checkpoints
 
 
+@pytest.mark.slow
 def test_ddp_ranks_stop_together_when_one_runs_out_of_time(vases32, tmp_path):
     run = tmp_path / "run"
     _torchrun(vases32, run, "rank1-out-of-time")  # the script asserts both end at step 1
