@@ -152,10 +152,8 @@ def encode_image(image: np.ndarray, fmt: str = "PNG", png_level: int = PNG_LEVEL
 def encode_png_fast(image: np.ndarray) -> bytes:
     """PNG bytes for bulk writers (radar synth): zlib level 1 and the Sub filter on every row, through OpenCV.
 
-    Pillow's level-6 PNGs are 2.5x slower to encode than level 1 (files ~25% smaller), and Pillow tries every row
-    filter where one does: on synthetic samples at 256 px this writes a sample's 7 PNGs in 11.3 ms instead of
-    18.4 ms at level 1 through Pillow, files 3% larger, pixels identical. Float arrays are taken as [0, 1], uint8
-    as is; H x W or H x W x 3 (RGB).
+    Where Pillow tries every row filter, this uses one: faster, files slightly larger, pixels identical
+    (docs/performance.md). Float arrays are taken as [0, 1], uint8 as is; H x W or H x W x 3 (RGB).
     """
     import cv2  # here, not at the top: `radar fetch` and the other light commands never load OpenCV
 

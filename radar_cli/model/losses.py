@@ -68,7 +68,7 @@ def mouth_l1(recon_mu: torch.Tensor, front: torch.Tensor, mouth: torch.Tensor, i
     coverage is on, the single-colour rendering shows the inside, its mean frontal colour dimmed by inside_dim.
     Fitting that darker ellipse to the image moves the rim, and with it the pitch, smoothly. Only the coverage
     carries gradient: the inside's colour is a crude model, and letting it teach the lighting and albedo made
-    both worse (measured: albedo si-MSE 4.9 -> 8.1 x 1e-2 on the 64 px test set).
+    both worse (docs/training.md).
 
     Args:
         recon_mu: B x 3 x H x W single-colour rendering of the frontal third (0 elsewhere).

@@ -1,5 +1,5 @@
 """Speed and memory benchmark of the renderer: silhouette + shading + frontal texture render + unwrap, forward and
-backward, for a batch of random vases at several image sizes (issue 2's `radar bench render`)."""
+backward, for a batch of random vases at several image sizes (`radar bench render`)."""
 
 from __future__ import annotations
 

@@ -122,8 +122,8 @@ def render_frontal(
 
 
 MAX_SPECULAR_SHARE = 0.8
-"""divide_shading's cap on the share of a texel's radiance taken as highlight; chosen with the bundled model on 460
-training vases among 0.5-1.0 (albedo si-MSE x 1e-2: 0.5 2.65, 0.7 2.42, 0.8 2.40, 0.9 2.45, 1.0 2.84; f_A 3.77)."""
+"""divide_shading's cap on the share of a texel's radiance taken as highlight, so an overestimated highlight leaves
+a dim texel rather than a black hole (how it was chosen: docs/derender.md)."""
 
 
 def divide_shading(

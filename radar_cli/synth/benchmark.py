@@ -1,4 +1,4 @@
-"""Throughput of `radar synth` (issue 3's speed target): samples per second written by the worker pool into a
+"""Throughput of `radar synth`: samples per second written by the worker pool into a
 temporary folder, and, in this process, the split of one sample's time between making it (texture, lighting,
 rendering every map) and writing its files."""
 

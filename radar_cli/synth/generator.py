@@ -54,8 +54,7 @@ class SynthConfig:
     """Rows (and frontal-third columns) of the albedo map; 0 = the image size (the 360 deg map is 3x wider)."""
     shading_size: int = 0
     """Side of the frontal-third grid the lighting is evaluated on; 0 = DEFAULT_SHADING (or size // 2 if smaller):
-    32 x 96 over the full turn, the paper's vertex grid. Finer grids change a 256 px image by 55 dB PSNR on average
-    (40 dB at worst, on 16 vases, measured against 64) and cost 4x more."""
+    32 x 96 over the full turn, the paper's vertex grid (how little finer grids change: docs/data.md)."""
     background: float = 1.0
     """Grey level of the plain background (1 = white, like museum photographs)."""
     random_roll: bool = False

@@ -39,6 +39,6 @@ def tiny() -> RunConfig:
 
 @pytest.fixture(autouse=True)
 def one_thread():
-    """One torch thread: on the shared 2-core machine two OpenMP threads oversubscribe and run ~20x slower."""
+    """One torch thread: on a shared 2-core machine two OpenMP threads oversubscribe (docs/performance.md, Threads)."""
     with torch_threads(1):
         yield

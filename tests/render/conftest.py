@@ -56,7 +56,7 @@ def random_sor():
 @pytest.fixture(autouse=True)
 def one_thread():
     """Run renderer tests on one intra-op thread: on a shared, busy CPU OpenMP's spinning threads cost more than
-    they gain at these small sizes (a 64 px render step: ~11 ms on one thread, ~0.4 s on two under load)."""
+    they gain at these small sizes (docs/performance.md, Threads)."""
     before = torch.get_num_threads()
     torch.set_num_threads(1)
     yield

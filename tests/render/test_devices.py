@@ -1,4 +1,4 @@
-"""Check 6 of issue 2: CPU and CUDA give the same renderings (skipped without CUDA).
+"""CPU and CUDA give the same renderings (skipped without CUDA).
 
 Geometry (silhouette, depth, normals) agrees within 1e-4 everywhere. Shaded colours agree within 1e-4 at all but a
 few values: the test textures are white noise (a jump of up to 1 between neighbouring texels), so a float32

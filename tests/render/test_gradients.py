@@ -1,4 +1,4 @@
-"""Check 2 of issue 2: autograd against central finite differences, for a silhouette loss (r, h, pitch, roll, tx,
+"""Autograd against central finite differences, for a silhouette loss (r, h, pitch, roll, tx,
 ty) and for a texture-rendering loss (texture and shape). Float64 so the differences are not rounding noise."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Check 3 of issue 2: inverse rendering from a cylinder at zero pose on the silhouette loss alone."""
+"""Inverse rendering from a cylinder at zero pose on the silhouette loss alone."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Check 1 of issue 2: silhouette and depth against trimesh ray casting of a dense (K = 256) triangle mesh."""
+"""Silhouette and depth against trimesh ray casting of a dense (K = 256) triangle mesh."""
 
 from __future__ import annotations
 

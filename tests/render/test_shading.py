@@ -1,4 +1,4 @@
-"""Check 5 of issue 2: one-texel environment light: Lambert diffuse value and the Eq. 7-8 specular peak within 2%."""
+"""One-texel environment light: Lambert diffuse value and the Eq. 7-8 specular peak within 2%."""
 
 from __future__ import annotations
 

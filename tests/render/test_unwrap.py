@@ -1,4 +1,4 @@
-"""Check 4 of issue 2: unwrapping a rendered textured vase gives back its frontal third (PSNR >= 30 dB, 128 px)."""
+"""Unwrapping a rendered textured vase gives back its frontal third (PSNR >= 30 dB, 128 px)."""
 
 from __future__ import annotations
 
