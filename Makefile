@@ -50,9 +50,9 @@ test-slow: $(STAMP)
 test-all: $(STAMP)
 	$(BIN)/python -m pytest -q tests
 
-# ruff on the package and the tests; mypy on the files pyproject.toml's [tool.mypy] names
+# ruff on the package, the tests and experiments/; mypy on the files pyproject.toml's [tool.mypy] names
 lint: $(STAMP)
-	$(BIN)/ruff check radar_cli tests
+	$(BIN)/ruff check radar_cli tests experiments
 	$(BIN)/mypy
 
 # CPU-vs-CUDA agreement of the renderer, the losses and the bundled model (each test skips without CUDA)

@@ -6,6 +6,7 @@ Each subcommand lives in its own module of this package and is registered in COM
 from __future__ import annotations
 
 import importlib
+
 import click
 
 from radar_cli import __version__

@@ -7,8 +7,8 @@ import json
 import click
 
 from radar_cli.cli.derender import RESOLUTION
-from radar_cli.derender.run.inputs import DEFAULT_RESOLUTION, Resolution
 from radar_cli.derender.refine.driver import REFINE_MODES
+from radar_cli.derender.run.inputs import DEFAULT_RESOLUTION, Resolution
 from radar_cli.errors import InputError
 
 

@@ -7,13 +7,13 @@ from pathlib import Path
 
 import click
 
-from radar_cli.derender.run.batch import DerenderOptions
-from radar_cli.derender.present.contact_sheet import contact_sheet as write_contact_sheet
 from radar_cli.derender.export.object_folder import MIN_VIEW_SIZE, ExportConfig
-from radar_cli.derender.run.inputs import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION, Resolution
-from radar_cli.derender.run.predictor import ALBEDO_SOURCES, PITCH_SOURCES, Predictor
+from radar_cli.derender.present.contact_sheet import contact_sheet as write_contact_sheet
 from radar_cli.derender.refine.driver import REFINE_MODES
+from radar_cli.derender.run.batch import DerenderOptions
+from radar_cli.derender.run.inputs import DEFAULT_RESOLUTION, MAX_RESOLUTION, MIN_RESOLUTION, Resolution
 from radar_cli.derender.run.launch import derender_sharded
+from radar_cli.derender.run.predictor import ALBEDO_SOURCES, PITCH_SOURCES, Predictor
 from radar_cli.derender.run.shard import Shard
 
 

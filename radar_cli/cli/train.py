@@ -8,7 +8,6 @@ import click
 
 from radar_cli.model.config import load_run_config
 
-
 OUT_OF_TIME_STATUS = 3
 
 
@@ -66,7 +65,8 @@ def train_reader(config_path: str | None, data_dir: str, out_dir: str, base: str
     """Teach the specular-albedo reader that `radar derender --refine` uses, from a model's f_L."""
     from radar_cli.config import load_toml
     from radar_cli.derender.run.predictor import bundled_checkpoint
-    from radar_cli.train.specular_reader import ReaderConfig, train_reader as run
+    from radar_cli.train.specular_reader import ReaderConfig
+    from radar_cli.train.specular_reader import train_reader as run
 
     config = load_toml(ReaderConfig, config_path) if config_path else ReaderConfig()
     summary = run(config, data_dir, out_dir, base or bundled_checkpoint(), say=click.echo)

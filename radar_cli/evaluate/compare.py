@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw
 
-from radar_cli.derender.present.contact_sheet import NAME_W, TILE, LABEL_H, tile
 from radar_cli.derender.export.quality import psnr
+from radar_cli.derender.present.contact_sheet import LABEL_H, NAME_W, TILE, tile
 from radar_cli.derender.present.report import read_records
 from radar_cli.errors import InputError
 from radar_cli.fileio import read_image, write_image, write_json

@@ -14,6 +14,7 @@ from radar_cli.fileio import number, read_image, read_json
 from radar_cli.results import ResultPaths
 from radar_cli.synth import layout
 
+
 @dataclass(frozen=True)
 class Truth:
     """Ground truth of one sample: images H x W (x 3) float in [0, 1], normals H x W x 3, env He x We."""

@@ -33,7 +33,8 @@ def load_module(module: nn.Module, tensors: dict[str, torch.Tensor], prefix: str
         module.load_state_dict(sub, strict=True)
     except RuntimeError as e:
         first = str(e).strip().splitlines()
-        raise CheckpointError(f"{path}: {prefix} weights do not fit the configuration ({' '.join(first)[:300]})") from None
+        message = " ".join(first)[:300]
+        raise CheckpointError(f"{path}: {prefix} weights do not fit the configuration ({message})") from None
 
 
 def read_checkpoint(path: str | Path) -> tuple[dict[str, torch.Tensor], dict[str, str], RunConfig]:

@@ -17,10 +17,10 @@ from dataclasses import dataclass
 import torch
 
 from radar_cli.config import CameraConfig
-from radar_cli.sor.camera import pixel_rays, pixel_size
-from radar_cli.sor.pose import rotation_matrix, translation
 from radar_cli.errors import InputError
 from radar_cli.render.intersect import Found, search
+from radar_cli.sor.camera import pixel_rays, pixel_size
+from radar_cli.sor.pose import rotation_matrix, translation
 from radar_cli.sor.profile import check_sor, row_coordinate, row_slopes
 from radar_cli.sor.solid import Solid
 

@@ -9,10 +9,10 @@ from typing import Callable
 
 import torch
 
+from radar_cli import distributed as D
 from radar_cli.fileio import write_text
 from radar_cli.model.config import RunConfig, load_run_config
 from radar_cli.model.losses import distance_transform
-from radar_cli import distributed as D
 from radar_cli.threads import torch_threads
 from radar_cli.train.step import Batch
 from radar_cli.train.trainer import build_state, train_step

@@ -28,7 +28,6 @@ from radar_cli.synth.layout import ALBEDO_FILE, ENV_MAP_FILE, PARAMS_FILE
 from radar_cli.train.step import Batch
 
 
-
 @dataclass(frozen=True)
 class Sample:
     """One preprocessed sample: image 3 x S x S uint8, mask S x S bool, dt S x S float32."""

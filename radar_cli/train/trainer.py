@@ -15,15 +15,22 @@ from pathlib import Path
 import torch
 from tqdm import tqdm
 
+from radar_cli import distributed as D
 from radar_cli.errors import InputError, RadarError
 from radar_cli.fileio import remove_stale_temps
 from radar_cli.model.config import RunConfig, TrainConfig
 from radar_cli.model.discriminator import PatchDiscriminator
 from radar_cli.model.losses import sad_discriminator_loss
 from radar_cli.model.radar import RadarModel
-from radar_cli import distributed as D
-from radar_cli.train.checkpoint import (MODEL_FILE, TrainState, export_weights, initialise, list_checkpoints,
-                                       restore, save_checkpoint)
+from radar_cli.train.checkpoint import (
+    MODEL_FILE,
+    TrainState,
+    export_weights,
+    initialise,
+    list_checkpoints,
+    restore,
+    save_checkpoint,
+)
 from radar_cli.train.data import StepBatchSampler, VaseDataset, make_loader, target_batch, to_batch
 from radar_cli.train.logging import RunLogger
 from radar_cli.train.step import Batch, generator_losses

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from radar_cli.derender.run.benchmark import bench_derender
 from radar_cli.derender.export.object_folder import ExportConfig
+from radar_cli.derender.run.benchmark import bench_derender
 
 
 def test_bench_derender_reports_rates(predictor) -> None:

@@ -21,12 +21,12 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.export.object_folder import ExportConfig
 from radar_cli.derender.present.gallery import THUMBNAIL_FILE
-from radar_cli.derender.run.predictor import Predictor
 from radar_cli.derender.present.report import write_report
 from radar_cli.derender.present.server import make_server
+from radar_cli.derender.run.batch import DerenderOptions, derender
+from radar_cli.derender.run.predictor import Predictor
 
 pytestmark = pytest.mark.browser
 REPO = Path(__file__).resolve().parents[2]
@@ -64,8 +64,8 @@ def browser():
 
 @pytest.fixture(scope="module")
 def results(tmp_path_factory) -> Path:
-    """The six synthetic example vases de-rendered by the bundled model; one object marked for review by a quality record and
-    attributed as if its photo came from `radar masks` (a meta.json beside it)."""
+    """The six synthetic example vases de-rendered by the bundled model; one object marked for review by a quality
+    record and attributed as if its photo came from `radar masks` (a meta.json beside it)."""
     out = tmp_path_factory.mktemp("browser") / "results"
     sample = out.parent / "prepared" / "test" / "met_1"
     sample.mkdir(parents=True)

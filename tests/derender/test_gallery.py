@@ -16,12 +16,20 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.export.object_folder import ExportConfig
-from radar_cli.derender.present.gallery import (GALLERY_DIR, PAGE_FILES, THUMB_SIDE, THUMBNAIL_FILE, VIEWER_ENV_FILE,
-                                        attribution, viewer_environment, write_gallery)
-from radar_cli.derender.run.predictor import Predictor
+from radar_cli.derender.present.gallery import (
+    GALLERY_DIR,
+    PAGE_FILES,
+    THUMB_SIDE,
+    THUMBNAIL_FILE,
+    VIEWER_ENV_FILE,
+    attribution,
+    viewer_environment,
+    write_gallery,
+)
 from radar_cli.derender.present.report import read_records, write_report
+from radar_cli.derender.run.batch import DerenderOptions, derender
+from radar_cli.derender.run.predictor import Predictor
 from radar_cli.render.lighting import env_directions
 
 from .conftest import SETUP, FakeModel, write_photo

@@ -12,8 +12,8 @@ import torch
 from PIL import Image
 
 from radar_cli.config import CameraConfig, GeometryConfig
-from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.export.object_folder import ExportConfig
+from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.run.predictor import ModelSetup, Predictor
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.texture import front_third

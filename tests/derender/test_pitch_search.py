@@ -11,9 +11,9 @@ import pytest
 import torch
 
 from radar_cli.derender.refine.pitch_search import PitchSearch, _grid_scores, parabola_vertex, score, search_pitch
-from radar_cli.model.losses import distance_transform
 from radar_cli.derender.run.predictor import ASSETS, Predictor
 from radar_cli.errors import InputError
+from radar_cli.model.losses import distance_transform
 from radar_cli.sor.solid import Solid
 
 from .test_predictor import save_weights, tiny_config

@@ -13,8 +13,8 @@ from click.testing import CliRunner
 
 from radar_cli.cli import cli
 from radar_cli.derender.run.predictor import Predictor
-from radar_cli.model import weights
 from radar_cli.errors import CheckpointError, InputError
+from radar_cli.model import weights
 
 from .conftest import write_photo
 
@@ -124,7 +124,8 @@ def test_missing_specular_reader_is_one_clear_error(tmp_path: Path) -> None:
     assert bundled.reader is not None and " + specular_albedo.safetensors#" in bundled.version  # material.json
     write_photo(tmp_path / "in" / "a.png", 1, (80, 80))
     result = CliRunner().invoke(cli, ["derender", str(tmp_path / "in"), "--out", str(tmp_path / "out"),
-                                      "--checkpoint", str(path), "--specular-reader", str(tmp_path / "nope.safetensors")])
+                                      "--checkpoint", str(path),
+                                      "--specular-reader", str(tmp_path / "nope.safetensors")])
     assert result.exit_code == 2
     (line,) = result.output.strip().splitlines()
     assert line.startswith("Error: ") and "nope.safetensors" in line

@@ -13,9 +13,9 @@ from click.testing import CliRunner
 from PIL import Image
 
 from radar_cli.cli import cli
-from radar_cli.derender.run.predictor import ASSETS
 from radar_cli.derender.export.quality import judge
 from radar_cli.derender.present.report import by_status, write_summary
+from radar_cli.derender.run.predictor import ASSETS
 from radar_cli.results import APPENDAGES_FILE, MATERIAL_FILE
 
 GOOD = {"silhouette_iou": 0.93, "symmetry": 0.95, "recon_psnr": 20.0, "appendage_fraction": 0.05,

@@ -3,7 +3,6 @@ and a failed fit falls back to the network's prediction."""
 
 from __future__ import annotations
 
-
 import numpy as np
 import pytest
 import torch

@@ -13,11 +13,11 @@ from click.testing import CliRunner
 from PIL import Image
 
 from radar_cli.cli import cli
-from radar_cli.derender.run.batch import DerenderOptions, derender
-from radar_cli.derender.present.contact_sheet import contact_sheet
 from radar_cli.derender.export.environments import builtin_environments, load_environment, normalise
 from radar_cli.derender.export.object_folder import ExportConfig
 from radar_cli.derender.export.renders import ViewRenderer
+from radar_cli.derender.present.contact_sheet import contact_sheet
+from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.run.state import read_state
 from radar_cli.errors import InputError
 from radar_cli.render.scene import render_view
@@ -28,8 +28,9 @@ from .conftest import SIZE, write_photo
 
 @pytest.fixture(scope="module")
 def obj(tmp_path_factory) -> Path:
-    from .conftest import SETUP, FakeModel
     from radar_cli.derender.run.predictor import Predictor
+
+    from .conftest import SETUP, FakeModel
 
     root = tmp_path_factory.mktemp("relight")
     write_photo(root / "in" / "vase.png", 7, (80, 80))

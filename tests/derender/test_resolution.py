@@ -16,8 +16,8 @@ from PIL import Image
 from scipy.ndimage import binary_erosion
 
 from radar_cli.cli import cli
-from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.export.object_folder import ExportConfig
+from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.run.inputs import InputItem, output_side, prepare
 from radar_cli.derender.run.predictor import ASSETS, Predictor
 from radar_cli.derender.run.upsample import PROFILE_ROWS, full_resolution_state
@@ -27,7 +27,8 @@ from .conftest import SETUP, SIZE, FakeModel, vase_photo, write_photo
 
 SIDE = 128
 IMAGE_SIDE = ("input.png", "mask.png", "mask_front.png", "recon.png", "albedo_rendered.png", "normal_rendered.png",
-              "diffuse_rendered.png", "specular_rendered.png", "texture.png", "normal.png", "diffuse.png", "specular.png", "relit_studio.png", "material_sphere.png")
+              "diffuse_rendered.png", "specular_rendered.png", "texture.png", "normal.png", "diffuse.png",
+              "specular.png", "relit_studio.png", "material_sphere.png")
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 

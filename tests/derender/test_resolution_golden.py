@@ -18,8 +18,8 @@ import numpy as np
 import trimesh
 from PIL import Image, ImageSequence
 
-from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.export.object_folder import ExportConfig
+from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.run.predictor import Predictor
 
 from .conftest import SETUP, FakeModel, write_photo

@@ -16,8 +16,8 @@ import pytest
 from click.testing import CliRunner
 
 from radar_cli.cli import cli
-from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.export.object_folder import ExportConfig
+from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.run.predictor import Predictor
 from radar_cli.derender.run.shard import Shard
 from radar_cli.errors import InputError

@@ -11,8 +11,16 @@ from click.testing import CliRunner
 
 from radar_cli.cli import cli
 from radar_cli.evaluate.from_truth import Perturbation, results_from_synth
-from radar_cli.evaluate.scorer import (PAPER_TABLE2, SampleScore, constant_baseline, constant_env_errors, evaluate,
-                                      markdown_table, pitch_calibration, report_json)
+from radar_cli.evaluate.scorer import (
+    PAPER_TABLE2,
+    SampleScore,
+    constant_baseline,
+    constant_env_errors,
+    evaluate,
+    markdown_table,
+    pitch_calibration,
+    report_json,
+)
 from radar_cli.results import ResultPaths
 from radar_cli.synth.generator import SynthConfig, generate
 

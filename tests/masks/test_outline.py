@@ -8,8 +8,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from radar_cli.derender.run.inputs import Prepared, located_input, white_backdrop
 from radar_cli.derender.export.quality import QualityLimits, assess_drawn, support
+from radar_cli.derender.run.inputs import Prepared, located_input, white_backdrop
 from radar_cli.masks.crop import CropBox
 from radar_cli.masks.outline import edge_contrast, outline_support
 from radar_cli.masks.synthetic import composite, render_vases

@@ -10,15 +10,23 @@ import pytest
 import torch
 
 from radar_cli.errors import ConfigError
-from radar_cli.model.config import load_run_config
 from radar_cli.model import losses as L
+from radar_cli.model.config import load_run_config
 from radar_cli.model.outputs import Decomposition
 from radar_cli.model.radar import RadarModel
 from radar_cli.render.lighting import tone_map
 from radar_cli.render.texture import full_from_front
 from radar_cli.synth.render import render_sample
-from radar_cli.train.step import (Batch, background_colour, divided_prediction, generator_losses, light_cycle_term,
-                                  redraw, relit, render_prediction)
+from radar_cli.train.step import (
+    Batch,
+    background_colour,
+    divided_prediction,
+    generator_losses,
+    light_cycle_term,
+    redraw,
+    relit,
+    render_prediction,
+)
 
 from .conftest import box_batch, tiny_config
 

@@ -8,7 +8,7 @@ import torch.nn.functional as F
 from radar_cli.config import CameraConfig
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_front
-from radar_cli.render.texture import full_from_front, front_third, unwrap
+from radar_cli.render.texture import front_third, full_from_front, unwrap
 from radar_cli.sor.camera import project
 from radar_cli.sor.surface import surface_grid
 from radar_cli.sor.solid import Solid

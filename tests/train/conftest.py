@@ -12,12 +12,12 @@ import torch
 
 from radar_cli.config import GeometryConfig, RenderConfig
 from radar_cli.dataset import sample_ref, write_sample
-from radar_cli.threads import torch_threads
 from radar_cli.model.config import LossConfig, ModelConfig, RunConfig, TrainConfig
+from radar_cli.render.material import Material
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_view
 from radar_cli.sor.solid import Solid
-from radar_cli.render.material import Material
+from radar_cli.threads import torch_threads
 
 
 def render_vases(root: Path, n: int, size: int, seed: int = 0) -> Path:

@@ -9,8 +9,8 @@ import torch
 from click.testing import CliRunner
 
 from radar_cli.cli import cli
-from radar_cli.train.benchmark import bench_train
 from radar_cli.model.weights import load_model
+from radar_cli.train.benchmark import bench_train
 from radar_cli.train.checkpoint import list_checkpoints
 from radar_cli.train.logging import loss_curve
 

@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 import torch
 
+from radar_cli import distributed as D
 from radar_cli.derender.run.predictor import Predictor
 from radar_cli.model.config import RunConfig
+from radar_cli.train.benchmark import elliptic_batch
 from radar_cli.train.step import generator_losses
 from radar_cli.train.trainer import build_state, train_step
-from radar_cli import distributed as D
-from radar_cli.train.benchmark import elliptic_batch
 
 from .conftest import tiny_config
 

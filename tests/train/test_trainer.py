@@ -8,8 +8,8 @@ import pytest
 import torch
 
 from radar_cli.errors import RadarError
-from radar_cli.train import trainer
 from radar_cli.model.weights import load_model
+from radar_cli.train import trainer
 from radar_cli.train.checkpoint import list_checkpoints
 from radar_cli.train.trainer import DivergedError, train
 

@@ -13,8 +13,16 @@ from radar_cli.fileio import atomic_path, encode_png_fast, to_uint8, write_bytes
 from radar_cli.render.lighting import tone_map
 from radar_cli.render.scene import shade
 from radar_cli.render.texture import front_third
-from radar_cli.results import (ALBEDO_FILE, DIFFUSE_FILE, ENV_HDR_FILE, ENV_MAP_FILE, ENV_PREVIEW_FILE,
-                               NORMAL_FILE, SPECULAR_FILE, TEXTURE_FILE)
+from radar_cli.results import (
+    ALBEDO_FILE,
+    DIFFUSE_FILE,
+    ENV_HDR_FILE,
+    ENV_MAP_FILE,
+    ENV_PREVIEW_FILE,
+    NORMAL_FILE,
+    SPECULAR_FILE,
+    TEXTURE_FILE,
+)
 
 ENV_PREVIEW_SCALE = 8  # the He x We map is tiny; the preview is enlarged (nearest) so texels stay visible
 FAST_ENCODE_PIXELS = 512 * 512

@@ -8,17 +8,16 @@ from pathlib import Path
 
 import numpy as np
 
-from radar_cli.derender.run.inputs import InputItem, Prepared
 from radar_cli.derender.export.maps import write_maps, write_picture
 from radar_cli.derender.export.mesh import write_meshes
-from radar_cli.derender.run.predictor import AlbedoSource, ModelSetup, PitchSource
 from radar_cli.derender.export.quality import assess_drawn
 from radar_cli.derender.export.renders import write_renders
+from radar_cli.derender.run.inputs import InputItem, Prepared
+from radar_cli.derender.run.predictor import AlbedoSource, ModelSetup, PitchSource
 from radar_cli.derender.run.state import ObjectState
 from radar_cli.fileio import write_json
 from radar_cli.results import APPENDAGES_FILE, INPUT_FILE, MATERIAL_FILE, SILHOUETTE_FILE
 from radar_cli.sizes import ObjectSize
-
 
 MIN_VIEW_SIZE = 128
 

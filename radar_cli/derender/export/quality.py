@@ -8,8 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from radar_cli.derender.run.inputs import Prepared
 from radar_cli.derender.export.renders import ViewRenderer
+from radar_cli.derender.run.inputs import Prepared
 from radar_cli.derender.run.state import ObjectState
 from radar_cli.masks.crop import outside_mask
 from radar_cli.masks.outline import outline_support

@@ -18,15 +18,25 @@ from radar_cli.derender.export.maps import FAST_ENCODE_PIXELS, chw_image, write_
 from radar_cli.derender.run.state import ObjectState
 from radar_cli.fileio import atomic_path, to_uint8
 from radar_cli.render.lighting import compose, tone_map
+from radar_cli.render.material import Material
 from radar_cli.render.raycast import Hits, cast_rays
 from radar_cli.render.scene import Shading, render_front, rotate_full_map, shade
 from radar_cli.render.texture import render_texture
-from radar_cli.sor.surface import FULL_SPAN
-from radar_cli.results import (ALBEDO_RENDERED_FILE, DIFFUSE_RENDERED_FILE, MASK_FILE, MASK_FRONT_FILE,
-                               MATERIAL_SPHERE_FILE, NORMAL_RENDERED_FILE, RECON_FILE, RELIT_PREFIX,
-                               SPECULAR_RENDERED_FILE, TURNTABLE_GIF_FILE, TURNTABLE_STRIP_FILE)
+from radar_cli.results import (
+    ALBEDO_RENDERED_FILE,
+    DIFFUSE_RENDERED_FILE,
+    MASK_FILE,
+    MASK_FRONT_FILE,
+    MATERIAL_SPHERE_FILE,
+    NORMAL_RENDERED_FILE,
+    RECON_FILE,
+    RELIT_PREFIX,
+    SPECULAR_RENDERED_FILE,
+    TURNTABLE_GIF_FILE,
+    TURNTABLE_STRIP_FILE,
+)
 from radar_cli.sor.solid import Solid
-from radar_cli.render.material import Material
+from radar_cli.sor.surface import FULL_SPAN
 
 SPHERE_ROWS = 64
 SPHERE_RADIUS = 0.8  # fraction of r_max

@@ -22,8 +22,16 @@ import numpy as np
 from radar_cli.derender.export.environments import builtin_environments
 from radar_cli.errors import RadarError
 from radar_cli.fileio import atomic_path, read_image, write_image, write_text
-from radar_cli.results import (APPENDAGES_FILE, ENV_MAP_FILE, INDEX_FILE, INPUT_FILE, MATERIAL_FILE, RECON_FILE,
-                               RELIT_PREFIX, SUMMARY_FILE)
+from radar_cli.results import (
+    APPENDAGES_FILE,
+    ENV_MAP_FILE,
+    INDEX_FILE,
+    INPUT_FILE,
+    MATERIAL_FILE,
+    RECON_FILE,
+    RELIT_PREFIX,
+    SUMMARY_FILE,
+)
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets" / "gallery"
 GALLERY_DIR = ".gallery"  # RESULTS/.gallery/: page code, viewer, data, built-in environments

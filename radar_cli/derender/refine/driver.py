@@ -1,10 +1,10 @@
 """Per-object refinement after the network (`radar derender --refine full`, the default): the shape and pose
-fitted to the silhouette and the rim at the crop's resolution (derender.refine.fit_shape), the lighting, material and
-albedo networks re-read at the fitted shape, the specular albedo read there by the specular-albedo reader
-(model.specular_reader; or f_L's, held at most 1), then the environment map fitted to the photograph's shading there
-(derender.refine.fit_light). A shape fit that fails, or draws the outline worse than the network's prediction, falls back
-to the network's and says why (material.json `refine`, summary.csv); a lighting fit with too few usable texels
-keeps the network's map. `--refine shape` stops after the re-reading."""
+fitted to the silhouette and the rim at the crop's resolution (derender.refine.fit_shape), the lighting, material
+and albedo networks re-read at the fitted shape, the specular albedo read there by the specular-albedo reader
+(model.specular_reader; or f_L's, held at most 1), then the environment map fitted to the photograph's shading
+there (derender.refine.fit_light). A shape fit that fails, or draws the outline worse than the network's
+prediction, falls back to the network's and says why (material.json `refine`, summary.csv); a lighting fit with
+too few usable texels keeps the network's map. `--refine shape` stops after the re-reading."""
 
 from __future__ import annotations
 

@@ -7,9 +7,9 @@ in closed form (the axis from the rows' midpoints, the profile from the rows' wi
 from the outline's top and bottom); each candidate is scored by how well it draws the outline plus how much its
 profile has to bend. Where the open mouth is visible, the rim's front arc is an edge in the image (the inside is
 darker than the outer wall below the lip) and its contrast picks the pitch; where the pot is painted in
-horizontal bands, their edges run straight across the texture unwrapped at the right pitch (derender.refine.bands), which
-picks the pitch or bounds the lip's search. A fine grid then narrows it, and the profile, height, roll and offset
-are polished by Adam at full resolution with the pitch held.
+horizontal bands, their edges run straight across the texture unwrapped at the right pitch
+(derender.refine.bands), which picks the pitch or bounds the lip's search. A fine grid then narrows it, and the
+profile, height, roll and offset are polished by Adam at full resolution with the pitch held.
 """
 
 from __future__ import annotations

@@ -149,7 +149,7 @@ def fit_lobes(problem: LobeProblem, start: torch.Tensor, k: int, paints: Callabl
     theta[3 * k:] = math.log(max(float(model @ target) / max(float(model @ model), 1e-30), 1e-12))
     for _ in range(rounds):
         albedo = paints(bake_lobes(theta, problem.size, False)[0])
-        theta = _levenberg_marquardt(lambda t, j: drawn(t, albedo, j), target, theta, steps, tolerance,
+        theta = _levenberg_marquardt(lambda t, j, albedo=albedo: drawn(t, albedo, j), target, theta, steps, tolerance,
                                      (k, min_elevation, lo, hi))
     return bake_lobes(theta, problem.size, False)[0]
 

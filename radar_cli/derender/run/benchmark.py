@@ -12,11 +12,11 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from radar_cli.derender.run.batch import EXPORT_THREADS, DerenderOptions, derender, environments
 from radar_cli.derender.export.object_folder import ExportConfig, export_object
+from radar_cli.derender.refine.driver import RefineMode
+from radar_cli.derender.run.batch import EXPORT_THREADS, DerenderOptions, derender, environments
 from radar_cli.derender.run.inputs import DEFAULT_RESOLUTION, InputItem, Resolution, output_side, prepare
 from radar_cli.derender.run.predictor import AlbedoSource, PitchSource, Predictor
-from radar_cli.derender.refine.driver import RefineMode
 from radar_cli.derender.run.upsample import full_resolution_state
 from radar_cli.fileio import write_image
 from radar_cli.threads import torch_threads
@@ -145,7 +145,8 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
 
     Returns:
         {"network_images_per_s", "network_images_per_cpu_s", "full_images_per_s", "full_seconds_per_image",
-         "resolution", "refine", "refine_seconds_per_object", "refine_cpu_seconds_per_object", "export_state_seconds", "export_write_seconds", "export_seconds_per_object",
+         "resolution", "refine", "refine_seconds_per_object", "refine_cpu_seconds_per_object",
+         "export_state_seconds", "export_write_seconds", "export_seconds_per_object",
          "export_cpu_seconds_per_object" (process CPU time: steadier than wall time on a shared machine),
          "rss_before_export_mib", "peak_rss_mib" (after the one-at-a-time exports), "full_peak_rss_mib" (after the
          full run with `workers` threads), "image_size", "photo_side", "batch_size", "n_images",

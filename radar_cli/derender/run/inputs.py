@@ -317,7 +317,8 @@ def located_input(photo: np.ndarray, size: int, name: str, backdrop: Backdrop = 
     h, w = photo.shape[:2]
     located = Prepared(resize_image(found.image, size), found.box, (w, h),
                        silhouette=resize_mask(found.silhouette, size),
-                       photo_image=resize_image(found.image, side), photo_silhouette=resize_mask(found.silhouette, side),
+                       photo_image=resize_image(found.image, side),
+                       photo_silhouette=resize_mask(found.silhouette, side),
                        appendages=resize_mask(found.appendages, side), cut_edges=found.cut_edges,
                        frame_coverage=round(found.frame_coverage, 4))
     return _on_backdrop(located, backdrop)

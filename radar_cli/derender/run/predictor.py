@@ -3,8 +3,8 @@ torch.no_grad. The only place that knows how a checkpoint becomes a model."""
 
 from __future__ import annotations
 
-import hashlib
 import dataclasses
+import hashlib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Literal
@@ -13,9 +13,9 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig
+from radar_cli.derender.refine.driver import REFINE_MODES, RefineMode, RefineReport, refine_object
 from radar_cli.derender.refine.fit_light import LightFitConfig
 from radar_cli.derender.refine.pitch_search import search_pitch
-from radar_cli.derender.refine.driver import REFINE_MODES, RefineMode, RefineReport, refine_object
 from radar_cli.errors import CheckpointError, InputError
 from radar_cli.model.outputs import Decomposition
 from radar_cli.model.radar import RadarModel
