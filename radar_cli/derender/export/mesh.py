@@ -6,6 +6,7 @@ unit) with the object's catalogued height when its size is known."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import trimesh
@@ -60,12 +61,15 @@ def write_meshes(folder: Path, state: ObjectState, n_cols: int, height_cm: float
     """
     mesh = build_mesh(state, n_cols)
     real = to_real_size(mesh, height_cm) if height_cm is not None else None
-    write_bytes(folder / MESH_GLB_FILE, mesh.export(file_type="glb"))
+    glb = mesh.export(file_type="glb")
+    assert isinstance(glb, bytes)  # a binary format
+    write_bytes(folder / MESH_GLB_FILE, glb)
+    material: Any = mesh.visual.material  # type: ignore[union-attr]  # build_mesh's TextureVisuals and PBRMaterial
     obj_mesh = mesh.copy()
     # OBJ/MTL is Phong: white Kd so viewers show the texture as is, Ns = shininess, Ks from the specular albedo
     spec = int(round(255 * min(float(state.material.rho[0]) / 2.0, MAX_SPECULAR_FACTOR)))
-    obj_mesh.visual.material = trimesh.visual.material.SimpleMaterial(
-        name="albedo", image=mesh.visual.material.baseColorTexture, diffuse=(255, 255, 255, 255),
+    obj_mesh.visual.material = trimesh.visual.material.SimpleMaterial(  # type: ignore[union-attr]
+        name="albedo", image=material.baseColorTexture, diffuse=(255, 255, 255, 255),
         ambient=(255, 255, 255, 255), specular=(spec, spec, spec, 255), glossiness=float(state.material.alpha[0]))
     text, files = trimesh.exchange.obj.export_obj(obj_mesh, include_texture=True, return_texture=True,
                                                   mtl_name="mesh.mtl")

@@ -68,6 +68,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
     folder.mkdir(parents=True, exist_ok=True)
     (folder / MATERIAL_FILE).unlink(missing_ok=True)  # incomplete until rewritten at the end
     side = prepared.side
+    assert prepared.photo_image is not None  # Prepared sets it
     write_picture(folder / INPUT_FILE, prepared.photo_image)
     if prepared.photo_silhouette is not None:
         write_picture(folder / SILHOUETTE_FILE, prepared.photo_silhouette.astype(np.uint8) * 255)

@@ -61,6 +61,7 @@ def support(prepared: Prepared) -> float | None:
     sil = prepared.photo_silhouette
     if sil is None or not sil.any():
         return None
+    assert prepared.photo_scene is not None  # Prepared sets it
     w, h = prepared.photo_size
     measurable = ~outside_mask(prepared.crop, (h, w), prepared.side)
     if prepared.appendages is not None:
@@ -77,6 +78,7 @@ def scores(prepared: Prepared, rendered: np.ndarray, recon: np.ndarray) -> dict:
         recon: N x N x 3 uint8 reconstruction of the input (over white).
     """
     sil = prepared.photo_silhouette
+    assert prepared.photo_image is not None  # Prepared sets it
     region = sil if sil is not None else rendered
     app = prepared.appendages
     whole = None if sil is None else int(sil.sum()) + (0 if app is None else int(app.sum()))

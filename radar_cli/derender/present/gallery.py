@@ -151,7 +151,9 @@ def real_size(rec: dict) -> dict | None:
 
 def object_entry(folder: Path, rec: dict, catalogs: dict[Path, sqlite3.Connection]) -> dict:
     """What the page knows of one object: id, quality, material, attribution and which files exist."""
-    quality = rec.get("quality") if isinstance(rec.get("quality"), dict) else {}
+    quality = rec.get("quality")
+    if not isinstance(quality, dict):
+        quality = {}
     relit = [e for e in rec.get("environments", []) if (folder / f"{RELIT_PREFIX}{e}.png").is_file()]
     return {
         "id": folder.name,
@@ -199,7 +201,8 @@ def write_gallery(root: Path, records: list[tuple[str, dict]], n_failed: int) ->
     gallery = root / GALLERY_DIR
     _copy_page_files(gallery)
     builtins = _write_builtin_environments(gallery)
-    entries, catalogs = [], {}
+    entries: list[dict] = []
+    catalogs: dict[Path, sqlite3.Connection] = {}
     try:
         for name, rec in records:
             try:

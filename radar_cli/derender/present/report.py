@@ -36,7 +36,7 @@ def by_status(records: list[tuple[str, dict]]) -> list[tuple[str, dict]]:
     def rank(item: tuple[str, dict]) -> tuple[int, str]:
         quality = item[1].get("quality")
         status = quality.get("status") if isinstance(quality, dict) else None
-        return STATUS_ORDER.get(status, len(STATUS_ORDER)), item[0]
+        return STATUS_ORDER.get(str(status), len(STATUS_ORDER)), item[0]
 
     return sorted(records, key=rank)
 
@@ -55,7 +55,9 @@ def write_summary(root: Path, records: list[tuple[str, dict]]) -> None:
         row["refine"], row["refine_reason"] = refine.get("status", ""), refine.get("reason", "")
         iou = (refine.get("silhouette_iou") or {}).get("refined")
         row["refine_iou"] = "" if iou is None else f"{iou:.4f}"
-        quality = rec.get("quality") if isinstance(rec.get("quality"), dict) else {}
+        quality = rec.get("quality")
+        if not isinstance(quality, dict):
+            quality = {}
         row.update({k: quality.get(k) for k in QUALITY_COLUMNS}, status=quality.get("status", ""),
                    reason="; ".join(quality.get("reasons", [])), cut_edges=" ".join(quality.get("cut_edges", [])))
         for k in ("pitch", "roll", "tx", "ty", "height", "alpha", "rho", "roughness") + QUALITY_COLUMNS:

@@ -28,7 +28,7 @@ class ResultsHandler(SimpleHTTPRequestHandler):
         self.quiet = quiet
         super().__init__(*args, directory=directory, **kwargs)
 
-    def send_head(self):  # type: ignore[override]
+    def send_head(self):
         """404 for anything whose real path leaves the root (a symlink out), else the base class's answer."""
         root = os.path.realpath(self.directory)
         real = os.path.realpath(self.translate_path(self.path))
@@ -37,7 +37,7 @@ class ResultsHandler(SimpleHTTPRequestHandler):
             return None
         return super().send_head()
 
-    def list_directory(self, path):  # type: ignore[override]
+    def list_directory(self, path):
         self.send_error(404, "No listing")
         return None
 
@@ -71,6 +71,7 @@ def serve(root: str | Path, port: int, say: Callable[[str], None], quiet: bool =
     """Serve `root` until interrupted, announcing the gallery's address through `say`."""
     server = make_server(root, port, quiet)
     host, bound = server.server_address[:2]
+    assert isinstance(host, str)  # an IPv4 or IPv6 server: its address is text
     say(f"gallery: http://{host}:{bound}/{INDEX_FILE}  (read-only, this computer only; Ctrl-C stops)")
     try:
         server.serve_forever()

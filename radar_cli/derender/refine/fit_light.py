@@ -129,7 +129,8 @@ def paint_labels(albedo: np.ndarray, config: LightFitConfig) -> np.ndarray:
     k = min(config.paints, len(pixels))
     cv2.setRNGSeed(0)
     criteria = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 30, 1e-3)
-    _, labels, centres = cv2.kmeans(pixels, k, None, criteria, 3, cv2.KMEANS_PP_CENTERS)
+    # OpenCV's stubs want an array for bestLabels; None (let it allocate) is what its documentation allows
+    _, labels, centres = cv2.kmeans(pixels, k, None, criteria, 3, cv2.KMEANS_PP_CENTERS)  # type: ignore[call-overload]
     labels = labels[:, 0]
     distance = np.linalg.norm(pixels - centres[labels], axis=1)
     share = np.bincount(labels, minlength=k) / len(labels)
@@ -177,7 +178,8 @@ def _texels(crop: np.ndarray, silhouette: np.ndarray, geo: Solid, start: torch.T
     if int(usable.sum()) < 0.05 * g * g:
         return None
     shown = texture[:3, usable]  # 3 x n display
-    kd, ks = phong_transport(normals[usable], view[usable], *env_directions(*start.shape, dtype=dtype), alpha)
+    directions = env_directions(start.shape[0], start.shape[1], dtype=dtype)
+    kd, ks = phong_transport(normals[usable], view[usable], *directions, alpha)
     diffuse, specular = kd @ start.reshape(-1), ks @ start.reshape(-1)  # n each
     divided = decompose(shown[None, :, None], diffuse[None, None], specular[None, None],
                         torch.tensor([rho], dtype=dtype), GAMMA)[0, :, 0]  # 3 x n linear
@@ -192,7 +194,7 @@ def _texels(crop: np.ndarray, silhouette: np.ndarray, geo: Solid, start: torch.T
 
 def _free_map(texels: _Texels, start: torch.Tensor, config: LightFitConfig) -> torch.Tensor:
     """The coarse free map (regularised least squares, alternating with the paints), upsampled: He x We."""
-    up = upsampler(config.coarse, tuple(start.shape))  # E x c
+    up = upsampler(config.coarse, (start.shape[0], start.shape[1]))  # E x c
     kd, ks = texels.kd @ up, texels.ks @ up  # n x c
     coarse_start = F.adaptive_avg_pool2d(start[None, None], config.coarse).reshape(-1)
     mean = float(coarse_start.mean())
@@ -239,7 +241,7 @@ def _fit(crop: np.ndarray, silhouette: np.ndarray, radius: torch.Tensor, height:
         return None
     free = _free_map(texels, start, config)
     transport = torch.cat([texels.kd, texels.ks]).T.float().contiguous()  # E x 2n
-    problem = LobeProblem(transport, texels.linear, rho, tuple(start.shape))
+    problem = LobeProblem(transport, texels.linear, rho, (start.shape[0], start.shape[1]))
     maps = []
     for k in config.lobe_counts:
         lobes = fit_lobes(problem, free, k, texels.paints, config.lobe_rounds, config.lobe_steps,

@@ -105,7 +105,8 @@ def huber(d: torch.Tensor, delta: float = 1.0) -> torch.Tensor:
 def outline_score(model: Outline, target: Outline, absolute: bool = False) -> torch.Tensor:
     """B scores: mean Huber (1 px) distance between a batch of outlines and one target over the rows and columns
     both cover, plus 2 per row or column only one of them covers (absolute=True: the mean |distance| instead)."""
-    total, count = 0.0, 0
+    total: torch.Tensor | float = 0.0
+    count = torch.zeros((), dtype=torch.long)
     for name in ("left", "right", "top", "bottom"):
         a = getattr(model, name)
         b = getattr(target, name).expand_as(a)

@@ -135,7 +135,7 @@ def fit_lobes(problem: LobeProblem, start: torch.Tensor, k: int, paints: Callabl
     theta = torch.cat([el, az, torch.full((2 * k,), math.log(start_sharpness), dtype=torch.float64)])
     theta[3 * k:] = 0.0
 
-    def drawn(theta: torch.Tensor, albedo: torch.Tensor, jacobian: bool) -> tuple[torch.Tensor, torch.Tensor | None]:
+    def drawn(theta: torch.Tensor, jacobian: bool, albedo: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor | None]:
         """The texels' linear radiance (3n) and its Jacobian (3n x 4k or None)."""
         env, jac = bake_lobes(theta, problem.size, jacobian)
         columns = env[None] if jac is None else torch.cat([env[None], jac.T])  # (1 + 4k) x E
@@ -145,11 +145,11 @@ def fit_lobes(problem: LobeProblem, start: torch.Tensor, k: int, paints: Callabl
         return rows[0], (rows[1:].T if jacobian else None)
 
     albedo = paints(start.reshape(-1))
-    model, _ = drawn(theta, albedo, False)
+    model, _ = drawn(theta, False, albedo)
     theta[3 * k:] = math.log(max(float(model @ target) / max(float(model @ model), 1e-30), 1e-12))
     for _ in range(rounds):
         albedo = paints(bake_lobes(theta, problem.size, False)[0])
-        theta = _levenberg_marquardt(lambda t, j, albedo=albedo: drawn(t, albedo, j), target, theta, steps, tolerance,
+        theta = _levenberg_marquardt(functools.partial(drawn, albedo=albedo), target, theta, steps, tolerance,
                                      (k, min_elevation, lo, hi))
     return bake_lobes(theta, problem.size, False)[0]
 
@@ -161,6 +161,7 @@ def _levenberg_marquardt(model: Callable[[torch.Tensor, bool], tuple[torch.Tenso
     (k, min elevation, min and max log sharpness)."""
     k, min_elevation, lo, hi = bounds
     value, jac = model(theta, True)
+    assert jac is not None  # asked for
     residual = value - target
     cost = float(residual @ residual)
     damping = LM_START_DAMPING
@@ -184,6 +185,7 @@ def _levenberg_marquardt(model: Callable[[torch.Tensor, bool], tuple[torch.Tenso
             damping *= 4
         if improved and gain >= tolerance:
             _, jac = model(theta, True)
+            assert jac is not None
         if not improved or gain < tolerance:
             break
     return theta

@@ -32,7 +32,8 @@ from radar_cli.fileio import remove_stale_temps
 from radar_cli.model.outputs import Decomposition
 from radar_cli.threads import torch_threads
 
-T, R = TypeVar("T"), TypeVar("R")
+T = TypeVar("T")
+R = TypeVar("R")
 EXPORT_THREADS = 1  # exports work on small tensors: one torch thread ran them 2-5x faster than two (2 cores)
 # errors of one object's export that must not stop the batch (decoding, writing, a degenerate prediction)
 ITEM_ERRORS = (RadarError, OSError, ValueError, RuntimeError)
@@ -224,6 +225,7 @@ def _export_all(ok: list[tuple[InputItem, Prepared]], todo: set[str], dec: Decom
         # another order than a one-worker run (different bytes)
         torch.set_num_threads(EXPORT_THREADS)
         item, prep = ok[k]
+        assert prep.photo_image is not None  # Prepared sets it
         try:
             refined, report = predictor.refine_object(dec.select(k), prep.image, prep.photo_image,
                                                       prep.photo_silhouette)

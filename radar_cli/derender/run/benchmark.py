@@ -93,6 +93,7 @@ def _export_cost(predictor: Predictor, photo_dir: Path, out: Path, resolution: R
     with torch_threads(EXPORT_THREADS):
         for k, (item, prep) in enumerate(zip(items, prepared)):
             start, cpu = time.perf_counter(), time.process_time()
+            assert prep.photo_image is not None  # Prepared sets it
             refined, report = predictor.refine_object(dec.select(k), prep.image, prep.photo_image,
                                                       prep.photo_silhouette)
             refine_s.append(time.perf_counter() - start)

@@ -329,7 +329,9 @@ def _on_backdrop(prepared: Prepared, backdrop: Backdrop) -> Prepared:
     backdrop)."""
     if backdrop == "white" and prepared.silhouette is not None:
         white = white_backdrop(prepared.image, prepared.silhouette)
-        photo = white if prepared.photo_image is prepared.image else white_backdrop(prepared.photo_image,
-                                                                                     prepared.photo_silhouette)
+        photo = white
+        if prepared.photo_image is not prepared.image:
+            assert prepared.photo_image is not None and prepared.photo_silhouette is not None  # set with silhouette
+            photo = white_backdrop(prepared.photo_image, prepared.photo_silhouette)
         return dataclasses.replace(prepared, image=white, photo_image=photo, backdrop="white")
     return prepared

@@ -7,7 +7,7 @@ import dataclasses
 import hashlib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Literal
+from typing import Callable, Literal, Sequence
 
 import numpy as np
 import torch
@@ -145,8 +145,8 @@ class Predictor:
         return cls(model, setup, version, dev, albedo, pitch, refine, specular)
 
     @torch.no_grad()
-    def predict(self, images: list[np.ndarray],
-                silhouettes: list[np.ndarray | None] | None = None) -> Decomposition:
+    def predict(self, images: Sequence[np.ndarray],
+                silhouettes: Sequence[np.ndarray | None] | None = None) -> Decomposition:
         """De-render a batch of crops.
 
         Args:
@@ -197,7 +197,7 @@ class Predictor:
                                         self.setup.camera, light=light, reader=self.reader)
         return (dec if refined is None else refined.to("cpu")), report
 
-    def _search_pitch(self, batch: torch.Tensor, silhouettes: list[np.ndarray | None],
+    def _search_pitch(self, batch: torch.Tensor, silhouettes: Sequence[np.ndarray | None],
                       dec: Decomposition) -> Decomposition:
         """`dec` with the searched pitch (and f_L, f_A re-read there) for the crops whose silhouette is known."""
         known = [i for i, m in enumerate(silhouettes) if m is not None]
@@ -209,7 +209,7 @@ class Predictor:
         return dec.combine(found, lambda t, f: t.index_copy(0, index, f))
 
 
-def _coverage(silhouettes: list[np.ndarray | None], size: int) -> torch.Tensor:
+def _coverage(silhouettes: Sequence[np.ndarray | None], size: int) -> torch.Tensor:
     """B x 1 x S x S float object coverage: each S x S mask, or all ones where none is known."""
     masks = [np.ones((size, size), bool) if m is None else m for m in silhouettes]
     for m in masks:
