@@ -26,9 +26,9 @@ from radar_cli.results import (
 
 ENV_PREVIEW_SCALE = 8  # the He x We map is tiny; the preview is enlarged (nearest) so texels stay visible
 FAST_ENCODE_PIXELS = 512 * 512
-"""Images of at least this many pixels are encoded for speed (fileio.encode_png_fast: zlib level 1, 7x faster
-than Pillow's level 6 on a 1,536 x 512 albedo, files a few % larger, pixels identical); smaller ones, every file
-of a network-size export included, keep Pillow's encoding."""
+"""Images of at least this many pixels are encoded for speed (fileio.encode_png_fast: zlib level 1, files a few %
+larger, pixels identical; docs/resolution.md); smaller ones, every file of a network-size export included, keep
+Pillow's encoding."""
 
 
 def write_picture(path: Path, image: np.ndarray) -> None:

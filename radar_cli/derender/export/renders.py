@@ -161,8 +161,8 @@ def material_sphere(state: ObjectState, size: int) -> np.ndarray:
 
 def gif_frames(views: list[np.ndarray]) -> list[Image.Image]:
     """GIF frames of H x W x 3 uint8 views: large ones (FAST_ENCODE_PIXELS) share one palette, made once by median
-    cut over all of them (Pillow's own per-frame palettes took 0.5 s of CPU for 8 frames at 512 px, this 0.1 s;
-    fast octree, 0.02 s, leaves 16 levels on a grey ramp); smaller ones are left to Pillow's per-frame palettes."""
+    cut over all of them (cheaper than Pillow's per-frame palettes, truer than its fast octree: docs/resolution.md);
+    smaller ones are left to Pillow's per-frame palettes."""
     if views[0].shape[0] * views[0].shape[1] < FAST_ENCODE_PIXELS:
         return [Image.fromarray(v) for v in views]
     height, width = views[0].shape[:2]

@@ -31,7 +31,7 @@ class LobeProblem:
 
     Attributes:
         transport: (He*We) x 2n float32: Kd and Ks (render.lighting.phong_transport) of the n used texels side by
-            side, transposed (float32 and this layout: the fit's products run 6x faster than in float64).
+            side, transposed (float32 and this layout keep the fit's products faster than float64 would).
         linear: 3 x n linear texture of the used texels.
         rho: specular albedo, held.
         size: (He, We) of the map.

@@ -34,7 +34,7 @@ from radar_cli.threads import torch_threads
 
 T = TypeVar("T")
 R = TypeVar("R")
-EXPORT_THREADS = 1  # exports work on small tensors: one torch thread ran them 2-5x faster than two (2 cores)
+EXPORT_THREADS = 1  # exports work on small tensors: one torch thread runs them faster (docs/performance.md, Threads)
 # errors of one object's export that must not stop the batch (decoding, writing, a degenerate prediction)
 ITEM_ERRORS = (RadarError, OSError, ValueError, RuntimeError)
 SHARED_TEMP_AGE_S = 60.0
@@ -54,7 +54,7 @@ class DerenderOptions:
     batch_size: int = 8
     workers: int = 2
     threads: int = 1
-    """torch intra-op threads for the network; on a busy 2-core machine one thread ran it 15x faster than two."""
+    """torch intra-op threads for the network (one: docs/performance.md, Threads)."""
     overwrite: bool = False
     export: ExportConfig = field(default_factory=ExportConfig)
     resolution: Resolution = DEFAULT_RESOLUTION
