@@ -14,6 +14,8 @@ from click.testing import CliRunner
 from radar_cli.cli import cli
 from radar_cli.errors import ConfigError, InputError
 from radar_cli.model.radar import RadarModel
+from radar_cli.model.weights import read_checkpoint
+from radar_cli.train.checkpoint import MODEL_FILE
 from radar_cli.train.data import VaseDataset, to_batch
 from radar_cli.train.step import generator_losses
 from radar_cli.train.trainer import train
@@ -105,5 +107,10 @@ def test_the_preset_trains_from_the_cli_with_labels(vases64, tmp_path):
     out = CliRunner().invoke(cli, args + ["--pitch-labels", str(results)])
     assert out.exit_code == 0, out.output
     assert "pitch_label=" in out.output
+    _, meta, config = read_checkpoint(tmp_path / "run" / MODEL_FILE)
+    stored = json.loads(meta["config"])  # the resolved preset: values from every base in its chain, no `base`
+    assert "base" not in stored and stored["name"] == "syn_cpu_selftrain"
+    assert stored["model"]["render"]["sil_sigma_px"] == 0.25 and stored["loss"]["cycle_albedo"] == "divided"
+    assert config.loss.pitch_label_weight == 1.0 and config.model.render.image_size == 64
     refused = CliRunner().invoke(cli, args)
     assert refused.exit_code != 0 and "--pitch-labels" in refused.output
