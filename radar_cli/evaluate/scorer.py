@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from tqdm import tqdm
@@ -84,9 +85,9 @@ class EvalReport:
     def skipped(self) -> int:
         return len(self.problems) + len(self.results_without_truth)
 
-    def summary(self) -> dict[str, dict[str, float]]:
+    def summary(self) -> dict[str, Any]:
         """{metric: {mean, std, rmse}} in raw units, plus the no-decomposition albedo bound."""
-        out = {}
+        out: dict[str, Any] = {}
         for key, *_ in METRICS:
             values = [getattr(s, key) for s in self.scores]
             out[key] = _stats(values)

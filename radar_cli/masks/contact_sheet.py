@@ -16,7 +16,7 @@ MAX_PER_SHEET = 200
 
 def thumbnail(image: np.ndarray, mask: np.ndarray, caption: str, accepted: bool) -> np.ndarray:
     """THUMB x THUMB x 3 uint8: the crop with the mask outline and a two-line caption."""
-    thumb = cv2.resize(image, (THUMB, THUMB), interpolation=cv2.INTER_AREA)
+    thumb: np.ndarray = cv2.resize(image, (THUMB, THUMB), interpolation=cv2.INTER_AREA)
     m = cv2.resize(mask.astype(np.uint8), (THUMB, THUMB), interpolation=cv2.INTER_NEAREST)
     colour = (40, 200, 40) if accepted else (220, 40, 40)
     contours, _ = cv2.findContours(m, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)

@@ -97,7 +97,7 @@ def crop_affine(crop: CropBox, size: int, scale: float = 1.0) -> np.ndarray:
 
 def warp_mask(mask: np.ndarray, affine: np.ndarray, size: int) -> np.ndarray:
     """Warp a bool mask by a 2 x 3 affine into a size x size bool mask (bilinear on 0/1, cut at 0.5)."""
-    src = mask.astype(np.float32)
+    src: np.ndarray = mask.astype(np.float32)
     if affine[0, 0] < 0.5:  # shrinking: average first so thin parts are not lost to point sampling
         factor = affine[0, 0]
         h, w = mask.shape

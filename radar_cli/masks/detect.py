@@ -218,7 +218,9 @@ def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float) ->
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
     cv2.setRNGSeed(0)  # GrabCut's k-means draws from a per-thread generator: the same cut in any thread
     try:
-        cv2.grabCut(np.ascontiguousarray(image), tri, None, bgd, fgd, COARSE_ITERATIONS, cv2.GC_INIT_WITH_MASK)
+        # OpenCV's stubs want a rectangle; None is what GC_INIT_WITH_MASK takes
+        cv2.grabCut(np.ascontiguousarray(image), tri, None, bgd, fgd, COARSE_ITERATIONS,  # type: ignore[call-overload]
+                    cv2.GC_INIT_WITH_MASK)
     except cv2.error:
         return raw
     cut = (tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)

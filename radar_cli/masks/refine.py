@@ -140,7 +140,9 @@ def _refine(image: np.ndarray, rough: np.ndarray, iterations: int, sure: np.ndar
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
     cv2.setRNGSeed(0)  # GrabCut's k-means draws from a per-thread generator: the same cut in any thread
     try:
-        cv2.grabCut(np.ascontiguousarray(gc_img), tri, None, bgd, fgd, iterations, cv2.GC_INIT_WITH_MASK)
+        # OpenCV's stubs want a rectangle; None is what GC_INIT_WITH_MASK takes
+        cv2.grabCut(np.ascontiguousarray(gc_img), tri, None, bgd, fgd, iterations,  # type: ignore[call-overload]
+                    cv2.GC_INIT_WITH_MASK)
     except cv2.error:
         return clean(rough, sigma), False
     cut = ((tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)).astype(np.float32)

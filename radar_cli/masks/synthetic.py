@@ -205,8 +205,8 @@ def non_sor_mask(kind: str, size: int, rng: np.random.Generator) -> np.ndarray:
             cv2.line(m, (c + int(dx * s), c), (c + int(dx * s), c + int(s * u(0.2, 0.28))), 1, max(3, s // 30))
     else:  # blob: a random star-ish polygon
         k = 9
-        ang = np.sort(rng.uniform(0, 2 * math.pi, k))
+        angles = np.sort(rng.uniform(0, 2 * math.pi, k))
         rad = rng.uniform(0.15, 0.4, k) * s
-        pts = np.stack([c + rad * np.cos(ang), c + rad * np.sin(ang)], 1)
+        pts = np.stack([c + rad * np.cos(angles), c + rad * np.sin(angles)], 1)
         cv2.fillPoly(m, [np.round(pts).astype(np.int32)], 1)
     return m > 0

@@ -83,7 +83,7 @@ def ragged(mask: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """The mask with a ragged outline (a hand-made cut-out): the edge moved in and out by up to ~1 % of the
     object's size, in patches."""
     size = math.sqrt(mask.sum())
-    noise = cv2.GaussianBlur(rng.normal(0, 1, mask.shape).astype(np.float32), (0, 0), max(1.0, size / 60))
+    noise: np.ndarray = cv2.GaussianBlur(rng.normal(0, 1, mask.shape).astype(np.float32), (0, 0), max(1.0, size / 60))
     noise /= max(float(np.abs(noise).max()), 1e-6)
     dist_in = cv2.distanceTransform(mask.astype(np.uint8), cv2.DIST_L2, 3)
     dist_out = cv2.distanceTransform((~mask).astype(np.uint8), cv2.DIST_L2, 3)
@@ -110,7 +110,7 @@ def add_label(photo: np.ndarray, mask: np.ndarray, rng: np.random.Generator) -> 
     img = photo.astype(np.float32) / 255.0
     free = ~(cv2.dilate(mask.astype(np.uint8), np.ones((15, 15), np.uint8)) > 0)
     s = min(H, W)
-    card = np.full((int(0.07 * s), int(0.28 * s), 3), 247, np.uint8)
+    card: np.ndarray = np.full((int(0.07 * s), int(0.28 * s), 3), 247, np.uint8)
     cv2.putText(card, "1984.12.3", (3, card.shape[0] - 5), cv2.FONT_HERSHEY_SIMPLEX, card.shape[0] / 45,
                 (0, 0, 0), 1)
     card = card.astype(np.float32) / 255.0
@@ -164,7 +164,7 @@ def make_variant(kind: str, photo: np.ndarray, mask: np.ndarray, rng: np.random.
     if kind == "backdrop":
         x0, y0, x1, y1 = tight_window(mask, rng)
         m = mask[y0:y1, x0:x1]
-        canvas = fill_backdrop(FILLS[index % len(FILLS)], *m.shape, rng)
+        canvas = fill_backdrop(FILLS[index % len(FILLS)], m.shape[0], m.shape[1], rng)
         return Variant(kind, paste(photo[y0:y1, x0:x1], m, canvas), m)
     if kind == "white":
         m = ragged(mask, rng)

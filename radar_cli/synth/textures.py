@@ -204,7 +204,7 @@ def procedural_texture(rng: np.random.Generator, height: int, width: int) -> np.
     c = _Canvas(height, width)
     palette = POTTERY_COLOURS[rng.choice(len(POTTERY_COLOURS), size=int(rng.integers(2, 6)), replace=False)]
     base = _pick(rng, palette)
-    tex = np.broadcast_to(base, (height, width, 3)).astype(np.float32)
+    tex: np.ndarray = np.broadcast_to(base, (height, width, 3)).astype(np.float32)
     if rng.random() < 0.4:  # a dipped glaze: another colour over the top or the bottom part
         split = float(rng.uniform(0.2, 0.8))
         edge = periodic_noise(rng, c, (1, 6)) * 0.08
@@ -261,7 +261,7 @@ def augment(tex: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, dict
     brightness = float(rng.uniform(1.0, 1.5))
     contrast = float(rng.uniform(1.0, 1.6))
     hue = float(rng.uniform(-180.0, 180.0))
-    out = np.clip(tex * brightness, 0.0, 1.0)
+    out: np.ndarray = np.clip(tex * brightness, 0.0, 1.0)
     grey = float((out @ np.array([0.299, 0.587, 0.114], dtype=np.float32)).mean())
     out = np.clip((out - grey) * contrast + grey, 0.0, 1.0).astype(np.float32)
     hsv = cv2.cvtColor(out, cv2.COLOR_RGB2HSV)  # float input: H in [0, 360)

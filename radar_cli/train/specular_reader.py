@@ -94,11 +94,10 @@ class _Split:
         data.load_targets()
         columns: dict[str, list] = {key: [] for key in ("radius", "height", "pose", "rho")}
         for ref, target in zip(data.refs, data.targets):
-            try:
-                for key, values in columns.items():
-                    values.append(target[key])
-            except (KeyError, TypeError):
-                raise InputError(f"{ref.folder}: params.json lacks {key} (not a radar synth sample)") from None
+            for key, values in columns.items():
+                if not isinstance(target, dict) or key not in target:
+                    raise InputError(f"{ref.folder}: params.json lacks {key} (not a radar synth sample)")
+                values.append(target[key])
         try:
             tensors = {key: torch.tensor(values, dtype=torch.float32) for key, values in columns.items()}
         except (ValueError, TypeError) as e:
