@@ -10,6 +10,7 @@ import math
 import cv2
 import numpy as np
 import torch
+
 from radar_cli.sor.solid import Solid
 
 BACKDROPS = ("plain", "gradient", "textured", "shadow", "label")

@@ -15,8 +15,8 @@ from radar_cli.model.light_net import LightNet
 from radar_cli.model.outputs import Decomposition
 from radar_cli.model.shape_net import ShapeNet
 from radar_cli.render.texture import unwrap
-from radar_cli.sor.surface import surface_grid
 from radar_cli.sor.solid import Solid
+from radar_cli.sor.surface import surface_grid
 
 
 class RadarModel(nn.Module):

@@ -12,11 +12,11 @@ import torch
 
 from radar_cli.config import CameraConfig, RenderConfig
 from radar_cli.errors import InputError
+from radar_cli.render.material import Material
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_front, shade
 from radar_cli.render.texture import unwrap
 from radar_cli.sor.solid import Solid
-from radar_cli.render.material import Material
 
 
 @dataclass(frozen=True)

@@ -16,13 +16,13 @@ import torch.nn.functional as F
 
 from radar_cli.checks import check_shape
 from radar_cli.config import CameraConfig, RenderConfig
-from radar_cli.render.material import Material
 from radar_cli.render.lighting import check_material, compose, decompose, shading_factors, upsample
+from radar_cli.render.material import Material
 from radar_cli.render.raycast import Hits, cast_rays
 from radar_cli.render.texture import render_texture, unwrap
 from radar_cli.sor.profile import check_sor
-from radar_cli.sor.surface import FRONT_SPAN, FULL_SPAN, surface_grid
 from radar_cli.sor.solid import Solid
+from radar_cli.sor.surface import FRONT_SPAN, FULL_SPAN, surface_grid
 
 
 @dataclass(frozen=True)

@@ -14,8 +14,8 @@ from radar_cli.config import CameraConfig
 from radar_cli.render.raycast import Hits
 from radar_cli.sor.camera import project
 from radar_cli.sor.profile import check_sor
-from radar_cli.sor.surface import FRONT_SPAN, SurfaceGrid, surface_grid
 from radar_cli.sor.solid import Solid
+from radar_cli.sor.surface import FRONT_SPAN, SurfaceGrid, surface_grid
 
 
 def front_third(texture: torch.Tensor) -> torch.Tensor:

@@ -18,6 +18,7 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -136,6 +137,7 @@ def make_sample(cfg: SynthConfig, split: str, index: int, textures: list[Path] |
     lobes = sample_lobes(rng)
     env = bake_env(lobes, render.env_height, render.env_width)
     tex_h, tex_w = render.tex_height, 3 * render.tex_width
+    texture_info: dict[str, Any]
     if textures:
         source = textures[int(rng.integers(len(textures)))]
         raw, texture_info = image_texture(source, rng, tex_h, tex_w), {"source": source.name}

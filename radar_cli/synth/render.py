@@ -14,10 +14,10 @@ import torch
 
 from radar_cli.config import CameraConfig, RenderConfig
 from radar_cli.render.lighting import TINY, power, tone_map
+from radar_cli.render.material import Material
 from radar_cli.render.scene import render_synthetic
 from radar_cli.render.texture import render_texture
 from radar_cli.sor.solid import Solid
-from radar_cli.render.material import Material
 
 
 @dataclass(frozen=True)

@@ -22,6 +22,7 @@ from torch import nn
 from radar_cli.errors import CheckpointError
 from radar_cli.fileio import atomic_path
 from radar_cli.model.config import RunConfig, to_dict
+from radar_cli.model.radar import RadarModel
 from radar_cli.model.specular_reader import SpecularReader
 from radar_cli.model.weights import FORMAT, READER_FORMAT, load_module, module_tensors, read_checkpoint
 
@@ -35,7 +36,7 @@ class TrainState:
     """Everything a run needs to continue exactly: the step to run next and the modules it updates."""
 
     step: int
-    model: nn.Module
+    model: RadarModel
     disc: nn.Module
     opt_model: torch.optim.Optimizer
     opt_disc: torch.optim.Optimizer

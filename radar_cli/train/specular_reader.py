@@ -26,11 +26,11 @@ from radar_cli.errors import CheckpointError, ConfigError, InputError
 from radar_cli.fileio import remove_stale_temps, write_image
 from radar_cli.model.specular_reader import SpecularReader
 from radar_cli.model.weights import load_model, read_specular_reader
+from radar_cli.sor.solid import Solid
 from radar_cli.threads import torch_threads
 from radar_cli.train.checkpoint import optimizer_tensors, restore_optimizer, save_specular_reader
 from radar_cli.train.data import VaseDataset
 from radar_cli.train.logging import loss_curve
-from radar_cli.sor.solid import Solid
 
 READER_FILE = "specular_reader.safetensors"
 LAST_FILE = "last.safetensors"

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from typing import cast
 
 import torch
 from torch import nn
@@ -130,7 +131,7 @@ def shape_cycle_term(shape_net: nn.Module, pred: Decomposition, background: torc
     pose[:, 0] = lo + (hi - lo) * torch.rand(pose.shape[0]).to(pose)
     image = redraw(target, pose, background, config)
     terms = L.geometry_l1(shape_net(image), (target.radius, target.height, pose), output_ranges(config))
-    return sum(terms.values())
+    return cast(torch.Tensor, sum(terms.values()))  # terms is never empty
 
 
 @torch.no_grad()
@@ -172,7 +173,7 @@ def light_cycle_term(model: RadarModel, pred: Decomposition, background: torch.T
     env, alpha, rho = model.light_net(texture, normals)
     terms = L.material_l1((model.albedo_net(texture), env, alpha, rho),
                           (target.albedo, target.env, target.alpha, target.rho), output_ranges(config))
-    return sum(terms.values())
+    return cast(torch.Tensor, sum(terms.values()))  # terms is never empty
 
 
 def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig, disc: nn.Module | None,
@@ -235,9 +236,11 @@ def generator_losses(pred: Decomposition, batch: Batch, config: RunConfig, disc:
         background = background_colour(batch.image, batch.mask)
         drawn = divided_prediction(pred, shading, batch, config) if lc.cycle_albedo == "divided" else pred
     if lc.cycle_weight > 0:
+        assert model is not None  # checked above
         terms["cycle"] = shape_cycle_term(model.shape_net, drawn, background, config)
         total = total + lc.cycle_weight * terms["cycle"]
     if lc.light_cycle_weight > 0:
+        assert model is not None  # checked above
         terms["light_cycle"] = light_cycle_term(model, drawn, background, config)
         total = total + lc.light_cycle_weight * terms["light_cycle"]
     terms["total"] = total

@@ -12,13 +12,13 @@ from radar_cli.errors import ConfigError
 from radar_cli.model import losses as L
 from radar_cli.model.radar import RadarModel
 from radar_cli.render.lighting import compose
+from radar_cli.render.material import Material
 from radar_cli.render.mouth import mouth_coverage
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_front, render_view, shade
+from radar_cli.sor.solid import Solid
 from radar_cli.synth.shapes import sample_shape
 from radar_cli.train.step import generator_losses
-from radar_cli.sor.solid import Solid
-from radar_cli.render.material import Material
 
 from .conftest import box_batch, tiny_config
 

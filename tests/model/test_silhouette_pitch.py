@@ -10,8 +10,8 @@ import torch
 
 from radar_cli.model.losses import distance_transform, silhouette_loss
 from radar_cli.render.raycast import cast_rays
-from radar_cli.synth.shapes import sample_shape
 from radar_cli.sor.solid import Solid
+from radar_cli.synth.shapes import sample_shape
 
 SIZE = 64
 PITCHES = np.arange(0.0, 20.01, 1.0)

@@ -7,11 +7,11 @@ import torch
 
 from radar_cli.errors import InputError
 from radar_cli.render.lighting import shading_factors
+from radar_cli.render.material import Material
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_view, shade
 from radar_cli.render.texture import render_texture, unwrap
 from radar_cli.sor.solid import Solid
-from radar_cli.render.material import Material
 
 
 def good(n: int = 2):

@@ -10,9 +10,9 @@ from __future__ import annotations
 import pytest
 import torch
 
+from radar_cli.render.material import Material
 from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_view, shade
-from radar_cli.render.material import Material
 from radar_cli.sor.solid import Solid
 
 
@@ -26,8 +26,8 @@ def test_cpu_and_cuda_agree(random_sor):
     alpha, rho = torch.tensor([5.0, 20.0, 60.0, 150.0]), torch.tensor([0.2, 0.5, 0.8, 1.0])
     outputs = {}
     for dev in ("cpu", "cuda"):
-        solid = Solid(radius, height, pose).map(lambda t: t.to(dev))
-        material = Material(albedo, env, alpha, rho).map(lambda t: t.to(dev))
+        solid = Solid(radius, height, pose).map(lambda t: t.to(dev))  # noqa: B023 (applied here)
+        material = Material(albedo, env, alpha, rho).map(lambda t: t.to(dev))  # noqa: B023 (applied here)
         hits = cast_rays(solid, 128)
         image, _ = render_view(solid, material, 128)
         front = shade(solid, material.with_albedo(albedo[..., 32:64].to(dev)))

@@ -9,9 +9,9 @@ import torch
 from radar_cli.config import RenderConfig
 from radar_cli.render import lighting
 from radar_cli.render.lighting import compose, decompose, env_directions, power, shading_factors, tone_map
+from radar_cli.render.material import Material
 from radar_cli.render.scene import shade
 from radar_cli.sor.solid import Solid
-from radar_cli.render.material import Material
 
 HE, WE = 16, 48
 

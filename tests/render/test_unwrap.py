@@ -10,8 +10,8 @@ from radar_cli.render.raycast import cast_rays
 from radar_cli.render.scene import render_front
 from radar_cli.render.texture import front_third, full_from_front, unwrap
 from radar_cli.sor.camera import project
-from radar_cli.sor.surface import surface_grid
 from radar_cli.sor.solid import Solid
+from radar_cli.sor.surface import surface_grid
 
 SIZE = 128
 TEX = (48, 48)

@@ -16,10 +16,10 @@ from radar_cli.errors import CheckpointError, ConfigError, InputError
 from radar_cli.model.radar import RadarModel
 from radar_cli.model.specular_reader import SpecularReader
 from radar_cli.model.weights import FORMAT, load_specular_reader, module_tensors
+from radar_cli.sor.solid import Solid
 from radar_cli.synth.generator import SynthConfig, make_sample, write_sample_folder
 from radar_cli.train.checkpoint import save_specular_reader
 from radar_cli.train.specular_reader import LAST_FILE, READER_FILE, ReaderConfig, train_reader
-from radar_cli.sor.solid import Solid
 
 from .conftest import tiny_config
 

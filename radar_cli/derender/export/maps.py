@@ -80,5 +80,6 @@ def write_maps(folder: Path, state: ObjectState, tex_render) -> None:
     write_picture(folder / TEXTURE_FILE, chw_image(s.texture))
     write_picture(folder / NORMAL_FILE, chw_image((s.normals + 1) / 2))
     write_picture(folder / DIFFUSE_FILE, chw_image(tone_map(s.diffuse, gamma)))
-    write_picture(folder / SPECULAR_FILE, chw_image(tone_map(state.material.rho[:, None, None, None] * s.specular, gamma)))
+    specular = state.material.rho[:, None, None, None] * s.specular
+    write_picture(folder / SPECULAR_FILE, chw_image(tone_map(specular, gamma)))
     write_env(folder, state.material.env[0].numpy(), gamma)

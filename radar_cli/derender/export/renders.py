@@ -111,7 +111,8 @@ def write_input_view(folder: Path, state: ObjectState, size: int) -> tuple[ViewR
     hits = view.hits
     coverage = torch.where(hits.mask, torch.ones_like(hits.sil), hits.sil)  # 1 x S x S
     write_picture(folder / MASK_FILE, to_uint8(coverage[0].numpy()))
-    _, front = render_front(hits, torch.ones_like(state.material.albedo[:, :1, :, : state.material.albedo.shape[-1] // 3]))
+    albedo = state.material.albedo
+    _, front = render_front(hits, torch.ones_like(albedo[:, :1, :, : albedo.shape[-1] // 3]))
     write_picture(folder / MASK_FRONT_FILE, to_uint8(front[0, 0].numpy()))
     # drawn as radar synth draws its ground truth (black off the hard silhouette), so radar eval compares like
     # with like at the outline

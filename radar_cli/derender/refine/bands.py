@@ -19,8 +19,8 @@ import torch
 
 from radar_cli.config import CameraConfig
 from radar_cli.render.texture import sample_surface
-from radar_cli.sor.surface import surface_grid
 from radar_cli.sor.solid import Solid
+from radar_cli.sor.surface import surface_grid
 
 
 @dataclass(frozen=True)

@@ -24,8 +24,8 @@ from radar_cli.model.outputs import Decomposition
 from radar_cli.model.specular_reader import SpecularReader
 from radar_cli.render.raycast import cast_rays
 from radar_cli.sor.outline import mask_outline, outline
-from radar_cli.threads import torch_threads
 from radar_cli.sor.solid import Solid
+from radar_cli.threads import torch_threads
 
 RefineMode = Literal["full", "shape", "none"]
 REFINE_MODES: tuple[RefineMode, ...] = ("full", "shape", "none")

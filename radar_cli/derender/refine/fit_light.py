@@ -35,9 +35,9 @@ from radar_cli.config import CameraConfig
 from radar_cli.derender.refine.light_lobes import LobeProblem, fit_lobes
 from radar_cli.render.lighting import GAMMA, decompose, env_directions, phong_transport, tone_map
 from radar_cli.render.texture import sample_surface
+from radar_cli.sor.solid import Solid
 from radar_cli.sor.surface import surface_grid
 from radar_cli.threads import torch_threads
-from radar_cli.sor.solid import Solid
 
 
 @dataclass(frozen=True)

@@ -227,7 +227,8 @@ def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor,
 
 
 def _search(target: Outline, grey: torch.Tensor, size: int, pitches: torch.Tensor, roll: float, tx: float,
-            config: ShapeFitConfig, camera: CameraConfig, lip_offset_px: float):
+            config: ShapeFitConfig, camera: CameraConfig,
+            lip_offset_px: float) -> tuple[tuple[torch.Tensor, torch.Tensor, torch.Tensor], torch.Tensor, torch.Tensor]:
     """Score a grid of candidate pitches: (shapes, outline + bending scores B, lip contrasts B)."""
     radius, height, pose = closed_form(target, size, pitches, roll, tx, config, camera)
     score = outline_score(outline(Solid(radius, height, pose), size, camera), target)
@@ -272,7 +273,7 @@ def search_pitch(target: Outline, grey: torch.Tensor, size: int, config: ShapeFi
     roll, tx = axis_from_outline(target, size, camera)
     coarse = torch.arange(0.0, config.pitch_max + 1e-6, config.coarse_step, dtype=torch.float64)
     shapes, score, contrast = _search(target, grey, size, coarse, roll, tx, config, camera, config.lip_offset_px)
-    coherence = None if bands is None else band_coherence(*bands, *shapes, config.bands, camera)
+    coherence = None if bands is None else band_coherence(bands[0], bands[1], *shapes, config.bands, camera)
     best, cue = _pick(score, contrast, coherence, coarse, config)
     if cue == "outline" and prior_pitch is not None:
         near = coarse - prior_pitch <= config.prior_reach

@@ -91,7 +91,7 @@ def _grid_scores(model: RadarModel, image: torch.Tensor, mask: torch.Tensor, dt:
         part = slice(start, start + per_call)
         # each of the chunk's n samples repeated G times, candidate-minor: (n * G) x ...
         image_g, mask_g, dt_g = (t[part].repeat_interleave(grid, dim=0) for t in (image, mask, dt))
-        first_g = first.map(lambda t: t[part].repeat_interleave(grid, dim=0))
+        first_g = first.map(lambda t: t[part].repeat_interleave(grid, dim=0))  # noqa: B023 (applied here)
         pitch = candidates[part].clamp(lo, hi).reshape(-1)  # (n * G)
         scores = score(model, image_g, mask_g, dt_g, first_g, pitch, search)
         chunks.append(scores.view(-1, grid))

@@ -205,7 +205,8 @@ class Predictor:
             return dec
         index = torch.tensor(known, device=self.device)
         part = dec.map(lambda t: t.index_select(0, index))
-        found = search_pitch(self.model, batch.index_select(0, index), [silhouettes[i] for i in known], part)
+        assert isinstance(self.model, RadarModel)  # __init__ refuses the search without one
+        found = search_pitch(self.model, batch.index_select(0, index), [m for m in silhouettes if m is not None], part)
         return dec.combine(found, lambda t, f: t.index_copy(0, index, f))
 
 

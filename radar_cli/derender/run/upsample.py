@@ -13,10 +13,10 @@ from radar_cli.derender.run.inputs import Prepared
 from radar_cli.derender.run.predictor import AlbedoSource, ModelSetup
 from radar_cli.derender.run.state import ObjectState
 from radar_cli.model.outputs import Decomposition
+from radar_cli.render.material import Material
 from radar_cli.render.scene import divide_shading, shade
 from radar_cli.sor.resample import smooth_rows
 from radar_cli.sor.solid import Solid
-from radar_cli.render.material import Material
 
 PROFILE_ROWS = 128
 """Rows of the exported profile away from the network's side (the meshes' rings; the renderer interpolates
