@@ -79,7 +79,7 @@ def remove_stale_temps(folder: str | Path, recursive: bool = False, min_age_s: f
     removed."""
     removed = 0
     now = time.time()
-    for root, dirs, files in os.walk(folder):
+    for root, _dirs, files in os.walk(folder):
         for name in files:
             path = Path(root) / name
             try:

@@ -11,7 +11,7 @@ import io
 import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 from radar_cli.errors import InputError
 
@@ -156,7 +156,8 @@ def read_size_table(path: str | Path) -> SizeTable:
             continue
         if object_id.casefold() in sizes:
             raise InputError(f"{where}: object {object_id!r} is given twice")
-        diameters = {field: centimetres(cells.get(col, ""), where, col) for col, field in DIAMETER_COLUMNS.items()}
+        diameters: dict[str, Any] = {field: centimetres(cells.get(col, ""), where, col)
+                                     for col, field in DIAMETER_COLUMNS.items()}
         sizes[object_id.casefold()] = ObjectSize(height_cm=height, **diameters, status="ok",
                                                  source=f"table {path.name}")
     return SizeTable(path, sizes)

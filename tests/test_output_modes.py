@@ -95,5 +95,6 @@ def test_synth_modes_and_eval_with_nothing_scored(tmp_path) -> None:
     (tmp_path / "results").mkdir()
     result = CliRunner().invoke(cli, ["eval", "--pred", str(tmp_path / "results"), "--gt", str(data)])
     assert result.exit_code == 1 and result.stdout == ""
-    assert result.stderr.strip().splitlines()[-1] == (f"Error: {tmp_path / 'results'}: nothing scored against {data} (0 result(s) "
-                                     "without ground truth, 1 sample(s) without a result, 0 unreadable)")
+    assert result.stderr.strip().splitlines()[-1] == (
+        f"Error: {tmp_path / 'results'}: nothing scored against {data} (0 result(s) without ground truth, "
+        "1 sample(s) without a result, 0 unreadable)")

@@ -15,7 +15,8 @@ import pytest
 REPO = Path(__file__).resolve().parents[1]
 BLOCK = re.compile(r"(?:(<!-- readme-test: skip \([^)]*\) -->)\n)?```(?:bash|sh)\n(.*?)```", re.S)
 SHIM = '#!/bin/sh\nexec "{python}" -m radar_cli "$@"\n'
-PRELUDE = 'set -euo pipefail\nmake() { [ "$*" = install ] || { echo "make $*: not run by this test" >&2; return 1; }; }\n'
+PRELUDE = ('set -euo pipefail\n'
+           'make() { [ "$*" = install ] || { echo "make $*: not run by this test" >&2; return 1; }; }\n')
 
 
 def blocks() -> list[tuple[bool, str]]:

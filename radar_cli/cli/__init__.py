@@ -35,7 +35,7 @@ class RadarUsageError(click.ClickException):
 
     def __init__(self, error: RadarError) -> None:
         super().__init__(str(error))
-        self.exit_code = error.exit_status
+        self.exit_code = error.exit_status  # type: ignore[misc]  # click declares it on the class; each error has its own
 
 
 class RadarGroup(click.Group):

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import click
 
-from radar_cli.evaluate.scorer import evaluate, markdown_table, report_json
 from radar_cli.errors import NothingToDoError
+from radar_cli.evaluate.scorer import evaluate, markdown_table, report_json
 from radar_cli.fileio import write_json
 
 

@@ -6,6 +6,7 @@ import dataclasses
 import sys
 from datetime import date
 from pathlib import Path
+from typing import Literal
 
 import click
 
@@ -49,9 +50,10 @@ def _check_date(ctx: click.Context, param: click.Parameter, value: str | None) -
 @click.option("--result-cap", type=int, default=10_000, hidden=True, help="Results one search can page.")
 @click.option("--page-size", type=int, default=500, hidden=True, help="Search page size.")
 @click.option("--progress/--no-progress", default=True, help="Show progress bars.")
-def fetch(query: str, out: Path, limit: int | None, department: int | None, public_domain: bool, image: str,
-          images: str, api_url: str, rate: float, user_agent: str, since: str | None, ids_file: Path | None, timeout: float,
-          block_wait: float, result_cap: int, page_size: int, progress: bool) -> None:
+def fetch(query: str, out: Path, limit: int | None, department: int | None, public_domain: bool,
+          image: Literal["original", "small"], images: Literal["primary", "all"], api_url: str, rate: float,
+          user_agent: str, since: str | None, ids_file: Path | None, timeout: float, block_wait: float,
+          result_cap: int, page_size: int, progress: bool) -> None:
     """Harvest a Met Collection API query into OUT: search, object records, then validated images.
 
     Resumable: rerun the same command after a crash or Ctrl-C. Exits 1 when objects or views failed or the API
@@ -60,9 +62,9 @@ def fetch(query: str, out: Path, limit: int | None, department: int | None, publ
     api_client = ClientConfig(rate=rate, user_agent=user_agent, timeout=timeout, block_wait=block_wait)
     config = HarvestConfig(
         out=out, query=query, limit=limit, department=department, public_domain_only=public_domain,
-        image=image, images=images, api_url=api_url, since=since, ids_file=ids_file, page_size=page_size, result_cap=result_cap,
-        api_client=api_client, image_client=dataclasses.replace(api_client, max_bytes=50 * 1024 * 1024),
-        progress=progress)  # type: ignore[arg-type]
+        image=image, images=images, api_url=api_url, since=since, ids_file=ids_file, page_size=page_size,
+        result_cap=result_cap, api_client=api_client,
+        image_client=dataclasses.replace(api_client, max_bytes=50 * 1024 * 1024), progress=progress)
     summary = harvest(config)
     click.echo(summary.line())
     if summary.aborted:

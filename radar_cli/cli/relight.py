@@ -19,7 +19,8 @@ from radar_cli.derender.export.relight import relight as run_relight
 @click.option("--size", type=int, default=None, help="Image side in pixels (default: the input's).")
 @click.option("--absolute", is_flag=True,
               help="Use the map's radiance as is (default: scaled to the exposure of the object's own lighting).")
-@click.option("--out", required=True, type=click.Path(dir_okay=False, path_type=Path), help="Image to write: .png, .jpg or .webp, in an existing folder.")
+@click.option("--out", required=True, type=click.Path(dir_okay=False, path_type=Path),
+              help="Image to write: .png, .jpg or .webp, in an existing folder.")
 def relight(object_dir: Path, env: str, yaw: float, pitch: float | None, size: int | None, absolute: bool,
             out: Path) -> None:
     """Relight OBJECT_DIR (a folder written by `radar derender`) without the network."""

@@ -62,7 +62,7 @@ def _segment_measures(segment: str) -> list[Measure]:
     labels = list(LABEL.finditer(prefix))
     part = (prefix[: labels[0].start()] if labels else prefix).strip(" :,.()").strip()
     place = prefix[labels[-1].end():].strip(" :,.()").lower() if labels else ""
-    kinds = [KINDS[m["label"].lower()] for m in labels]
+    kinds: list[str | None] = [KINDS[m["label"].lower()] for m in labels]
     if len(kinds) == 1 and "max" in prefix.lower() and kinds[0] == "diameter":
         place = place or "max"
     if len(kinds) != len(values):  # unlabelled "46 5/8 x 18 3/4 in.", or labels that do not match the values

@@ -16,8 +16,8 @@ import csv
 import fcntl
 import io
 import os
-from contextlib import contextmanager
 from collections import Counter
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Iterator, Literal

@@ -23,7 +23,7 @@ from typing import Iterator
 import cv2
 from tqdm import tqdm
 
-from radar_cli.dataset import sample_ref, safe_id, write_sample
+from radar_cli.dataset import safe_id, sample_ref, write_sample
 from radar_cli.errors import InputError, NothingToDoError
 from radar_cli.fileio import remove_stale_temps, write_json, write_text
 from radar_cli.masks.contact_sheet import write_sheets

@@ -47,7 +47,8 @@ def predictor() -> Predictor:
 def fake_checkpoint(monkeypatch, predictor: Predictor) -> None:
     """`radar derender` loads the tiny untrained `predictor` whatever --checkpoint says."""
     monkeypatch.setattr(Predictor, "from_checkpoint",
-                        classmethod(lambda cls, path, device, albedo, pitch, refine="none", reader="bundled": predictor))
+                        classmethod(lambda cls, path, device, albedo, pitch, refine="none", reader="bundled":
+                                    predictor))
 
 
 def vase_photo(seed: int, shape: tuple[int, int] = (SIZE, SIZE)) -> np.ndarray:

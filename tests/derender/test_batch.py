@@ -15,8 +15,8 @@ from click.testing import CliRunner
 from PIL import Image
 
 from radar_cli.cli import cli
-from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.export.object_folder import ExportConfig
+from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.run.predictor import Predictor
 from radar_cli.results import MATERIAL_KEYS, ResultPaths, list_results
 

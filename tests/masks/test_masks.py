@@ -22,6 +22,7 @@ from radar_cli.masks.quality import Thresholds, score_mask, sor_score
 from radar_cli.masks.refine import iou
 from radar_cli.masks.synthetic import NON_SOR, composite, non_sor_mask, render_vases, sor_mask
 
+
 @pytest.fixture(scope="module")
 def vases():
     return render_vases(3, 128, seed=3)

@@ -20,11 +20,21 @@ from tqdm import tqdm
 
 from radar_cli.derender.export.environments import builtin_environments, env_name, load_environment
 from radar_cli.derender.export.object_folder import ExportConfig, export_object, is_complete
-from radar_cli.derender.run.inputs import (DEFAULT_RESOLUTION, Backdrop, CropMode, Failure, InputItem, Prepared,
-                                       Resolution, collect_inputs, output_side, prepare)
+from radar_cli.derender.present.report import write_report
+from radar_cli.derender.run.inputs import (
+    DEFAULT_RESOLUTION,
+    Backdrop,
+    CropMode,
+    Failure,
+    InputItem,
+    Prepared,
+    Resolution,
+    collect_inputs,
+    output_side,
+    prepare,
+)
 from radar_cli.derender.run.object_size import SizeFinder
 from radar_cli.derender.run.predictor import Predictor
-from radar_cli.derender.present.report import write_report
 from radar_cli.derender.run.shard import Shard, read_share_failures, write_share_failures
 from radar_cli.derender.run.upsample import full_resolution_state
 from radar_cli.errors import InputError, NothingToDoError, RadarError
