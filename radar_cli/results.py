@@ -47,6 +47,7 @@ MESH_OBJ_FILE = "mesh.obj"
 MATERIAL_SPHERE_FILE = "material_sphere.png"
 TURNTABLE_GIF_FILE = "turntable.gif"
 TURNTABLE_STRIP_FILE = "turntable.png"
+COVERAGE_FILE = "coverage.png"  # objects with several views: which view gave each texel of albedo.png (black: none)
 RELIT_PREFIX = "relit_"  # relit_<environment>.png
 
 # material.json keys that `radar eval` reads (others may be present)

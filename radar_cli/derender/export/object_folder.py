@@ -45,7 +45,7 @@ def is_complete(folder: Path) -> bool:
 def export_object(folder: Path, item: InputItem, prepared: Prepared, state: ObjectState, setup: ModelSetup,
                   version: str, envs: dict[str, np.ndarray], config: ExportConfig = ExportConfig(),
                   albedo_source: AlbedoSource = "network", pitch_source: PitchSource = "network",
-                  refine: dict | None = None, size: ObjectSize | None = None) -> dict:
+                  refine: dict | None = None, size: ObjectSize | None = None, extra: dict | None = None) -> dict:
     """Write all files of one object; image-space outputs at the output side N = prepared.side.
 
     Args:
@@ -61,6 +61,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         refine: what the per-object refinement did (derender.refine.driver.RefineReport.record()), if it ran.
         size: the object's catalogued size, if known (meshes in metres at its height); one without a height
             leaves them unitless and says why in material.json.
+        extra: more entries for material.json (an object with several views: derender.multiview.driver).
 
     Returns:
         The material.json record.
@@ -93,6 +94,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         "environments": sorted(envs),
         "quality": assess_drawn(prepared, drawn, recon),
         **size_record(size, real),
+        **(extra or {}),
     })
     write_json(folder / MATERIAL_FILE, record)
     return record

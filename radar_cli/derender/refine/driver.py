@@ -130,16 +130,27 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
         return None, dataclasses.replace(report, status="fallback",
                                         reason=f"the fit drew the silhouette worse (IoU {refined_iou:.3f} "
                                                f"against the network's {network_iou:.3f})")
+    refined, report = read_at_shape(model, image, dec, Solid(fit.radius, fit.height, fit.pose), crop, silhouette,
+                                    camera, light, reader, report)
+    return refined, dataclasses.replace(report, seconds=time.perf_counter() - start)
+
+
+def read_at_shape(model, image: torch.Tensor, dec: Decomposition, geo: Solid, crop: np.ndarray, silhouette: np.ndarray,
+                  camera: CameraConfig, light: LightFitConfig | None, reader: SpecularReader | None,
+                  report: RefineReport) -> tuple[Decomposition, RefineReport]:
+    """The appearance at a fitted shape: lighting, material and albedo re-read there by the networks, the specular
+    albedo by `reader` (None: f_L's, at most 1), the environment map fitted to the crop's shading (light None:
+    the re-reading kept). geo: the fitted solid (radius 1 x L, height 1, pose 1 x 4); the rest as refine_object."""
     device = image.device
     with torch.no_grad():
-        solid = Solid(fit.radius, fit.height, fit.pose).map(lambda t: t.to(device))
+        solid = geo.map(lambda t: t.to(device))
         refined = model.read_appearance(image, solid).detach()
         rho = refined.rho.clamp(max=MAX_SPECULAR_ALBEDO) if reader is None else reader(image, solid)
     refined = dataclasses.replace(refined, rho=rho)
     report = dataclasses.replace(report, specular="network" if reader is None else "reader")
     if light is not None:
         refined, report = _fit_light(refined, dec.env, crop, silhouette, camera, light, report)
-    return refined, dataclasses.replace(report, seconds=time.perf_counter() - start)
+    return refined, report
 
 
 def _fit_light(refined: Decomposition, network_env: torch.Tensor, crop: np.ndarray, silhouette: np.ndarray,

@@ -20,6 +20,7 @@ from tqdm import tqdm
 
 from radar_cli.derender.export.environments import builtin_environments, env_name, load_environment
 from radar_cli.derender.export.object_folder import ExportConfig, export_object, is_complete
+from radar_cli.derender.multiview.driver import derender_views
 from radar_cli.derender.present.report import write_report
 from radar_cli.derender.run.inputs import (
     DEFAULT_RESOLUTION,
@@ -182,14 +183,19 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
     for f in summary.failures:
         say(f.line())
     options.out.mkdir(parents=True, exist_ok=True)
-    batches = shard.blocks(items, options.batch_size)
-    with sizes, torch_threads(options.threads), tqdm(total=sum(map(len, batches)), desc="derender", unit="obj",
-                                                     disable=None) as bar:
+    batches = shard.blocks([i for i in items if not i.multiview], options.batch_size)
+    several = [block[0] for block in shard.blocks([i for i in items if i.multiview], 1)]
+    with sizes, torch_threads(options.threads), tqdm(total=sum(map(len, batches)) + len(several), desc="derender",
+                                                     unit="obj", disable=None) as bar:
         for batch in batches:
             todo = _pending(batch, options.out, options.overwrite, summary, say)
             if todo:
                 _run_batch(batch, todo, predictor, options, envs, summary, say, sizes)
             bar.update(len(batch))
+        for item in several:
+            if _pending([item], options.out, options.overwrite, summary, say):
+                _run_views(item, predictor, options, envs, summary, say, sizes)
+            bar.update(1)
     if shard.enabled:
         write_share_failures(options.out, shard, summary.failures)
     if report:
@@ -219,6 +225,23 @@ def _run_batch(chunk: list[InputItem], todo: set[str], predictor: Predictor, opt
     dec = predictor.predict([prep.image for _, prep in ok], [prep.silhouette for _, prep in ok])
     with torch_threads(EXPORT_THREADS):
         _export_all(ok, todo, dec, predictor, options, envs, summary, say, sizes)
+
+
+def _run_views(item: InputItem, predictor: Predictor, options: DerenderOptions, envs: dict[str, np.ndarray],
+               summary: BatchSummary, say: Callable[[str], None], sizes: SizeFinder) -> None:
+    """One object photographed from several sides (derender.multiview.driver); its unreadable photos are recorded
+    as failures, the object is done with the others."""
+    try:
+        with torch_threads(EXPORT_THREADS):
+            left_out = derender_views(item, predictor, options.out, options.crop, options.backdrop,
+                                      options.resolution, envs, options.export, say, sizes.find(item))
+    except ITEM_ERRORS as e:
+        failure = Failure(str(item.image_path.parent), f"multi-view object failed ({type(e).__name__}: {e})")
+        summary.failures.append(failure)
+        say(failure.line())
+        return
+    summary.failures.extend(left_out)
+    summary.done.append(item.name)
 
 
 def _export_all(ok: list[tuple[InputItem, Prepared]], todo: set[str], dec: Decomposition, predictor: Predictor,

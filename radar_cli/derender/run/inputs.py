@@ -17,6 +17,9 @@ from radar_cli.fileio import read_image
 from radar_cli.masks.crop import CropBox, cut, mask_box, square_box
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".webp", ".tif", ".tiff")
+FIRST_VIEW_NAMES = ("front", "primary", "a")
+"""A multi-view object's photo with one of these stems is its first view (the others' turns are relative to it and
+its results are drawn from it); else the first by name."""
 CropMode = Literal["auto", "none"]
 Backdrop = Literal["keep", "white"]
 Resolution = Union[int, Literal["photo"]]
@@ -52,12 +55,19 @@ class InputItem:
         image_path: the photo.
         mask_path: a known silhouette (--masks or the dataset sample's), used to crop; None if unknown.
         is_crop: the image is already a network crop (a prepared dataset sample): used whole.
+        views: an object photographed from several sides (a sub-folder of an input folder holding two or more
+            photos): all its photos, the first view first (image_path); () for a single photo.
     """
 
     name: str
     image_path: Path
     mask_path: Path | None = None
     is_crop: bool = False
+    views: tuple[Path, ...] = ()
+
+    @property
+    def multiview(self) -> bool:
+        return len(self.views) > 1
 
 
 @dataclass(frozen=True)
@@ -136,7 +146,18 @@ def _folder_items(folder: Path, masks: Path | None) -> list[InputItem]:
     if samples:
         return [InputItem(p.parent.name, p, _existing(p.parent / MASK_FILE), is_crop=True) for p in samples]
     images = sorted(p for p in folder.rglob("*") if p.is_file() and _is_image(p))
-    return [InputItem(p.stem, p, _mask_for(p, masks)) for p in images]
+    by_folder: dict[Path, list[Path]] = {}
+    for p in images:
+        by_folder.setdefault(p.parent, []).append(p)
+    items = []
+    for p in images:
+        views = by_folder[p.parent]
+        if p.parent == folder or len(views) < 2:
+            items.append(InputItem(p.stem, p, _mask_for(p, masks)))
+        elif p == views[0]:
+            ordered = tuple(sorted(views, key=lambda v: (v.stem.lower() not in FIRST_VIEW_NAMES, v.name)))
+            items.append(InputItem(p.parent.name, ordered[0], views=ordered))
+    return items
 
 
 def _existing(path: Path) -> Path | None:
@@ -156,7 +177,8 @@ def collect_inputs(paths: list[str | Path], masks: str | Path | None = None,
 
     Files must have an image suffix; folders are searched recursively for images (other files, such as a
     SOURCES.tsv, are ignored); a folder with no image is a failure. Names are the file stems, made safe and
-    unique.
+    unique. Below an input folder, a sub-folder directly holding two or more photos is one object seen from
+    several sides (InputItem.views), named by the sub-folder.
 
     Args:
         paths: files and folders, in order.

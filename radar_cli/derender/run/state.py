@@ -57,13 +57,19 @@ class ObjectState:
     render: RenderConfig
     camera: CameraConfig
 
+    @staticmethod
+    def export_render(render: RenderConfig) -> RenderConfig:
+        """The renderer settings of whole-object renders: the model's, the shading grid at most
+        EXPORT_SHADING_GRID."""
+        return dataclasses.replace(render, shading_height=min(render.shading_height, EXPORT_SHADING_GRID),
+                                   shading_width=min(render.shading_width, EXPORT_SHADING_GRID))
+
     @classmethod
     def from_decomposition(cls, dec: Decomposition, render: RenderConfig, camera: CameraConfig) -> "ObjectState":
         """The state of a batch-of-one Decomposition; the frontal albedo is mirrored to 360 deg."""
         if dec.radius.shape[0] != 1:
             raise ValueError(f"expected a batch of one, got {dec.radius.shape[0]}")
-        export_render = dataclasses.replace(render, shading_height=min(render.shading_height, EXPORT_SHADING_GRID),
-                                            shading_width=min(render.shading_width, EXPORT_SHADING_GRID))
+        export_render = cls.export_render(render)
         albedo = quantise(full_from_front(dec.albedo.float().clamp(0, 1)), render.gamma)
         material = dec.material.map(torch.Tensor.float).with_albedo(albedo)
         return cls(dec.solid.map(torch.Tensor.float), material, export_render, camera)

@@ -1,0 +1,89 @@
+"""`radar derender` for an object photographed from several sides (a sub-folder of photos, run.inputs): its views
+read and cropped (an unreadable photo is left out with one line, the object goes on with the others), the network
+run on them as one batch, the object fitted from all of them (multiview.fit) and exported from its first used view
+with the fused albedo, coverage.png and material.json's `views`."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from radar_cli.derender.export.maps import write_picture
+from radar_cli.derender.export.object_folder import ExportConfig, export_object
+from radar_cli.derender.multiview.fit import MultiviewConfig, ObjectFit, ViewFit, fit_object, object_state, views_record
+from radar_cli.derender.run.inputs import (Backdrop, CropMode, Failure, InputItem, Prepared, Resolution, prepare,
+                                           resize_image, resize_mask)
+from radar_cli.derender.run.predictor import Predictor
+from radar_cli.errors import InputError, RadarError
+from radar_cli.results import COVERAGE_FILE
+from radar_cli.sizes import ObjectSize
+
+
+def same_side(prepared: Prepared, side: int) -> Prepared:
+    """A view's output-side crops at `side` (views cropped from photos of different sizes)."""
+    if prepared.side == side:
+        return prepared
+    resized = {name: resize_image(getattr(prepared, name), side) for name in ("photo_image", "photo_scene")}
+    masks = {name: None if getattr(prepared, name) is None else resize_mask(getattr(prepared, name), side)
+             for name in ("photo_silhouette", "appendages")}
+    return dataclasses.replace(prepared, **resized, **masks)
+
+
+def read_views(item: InputItem, size: int, crop: CropMode, backdrop: Backdrop, resolution: Resolution,
+               say: Callable[[str], None]) -> tuple[list[ViewFit], list[Failure]]:
+    """Every photo of the object prepared (prepare) at the smallest view's output side; an unreadable one is a
+    ViewFit without crops, a Failure and one line."""
+    views, failures = [], []
+    for path in item.views:
+        try:
+            views.append(ViewFit(str(path), prepare(InputItem(item.name, path), size, crop, backdrop, resolution)))
+        except RadarError as e:
+            problem = str(e).removeprefix(f"{path}: ")
+            failure = Failure(str(path), f"{problem}; left out, {item.name} goes on with its other views")
+            say(failure.line())
+            failures.append(failure)
+            views.append(ViewFit(str(path), None, reason=f"unreadable ({problem})"))
+    readable = [v for v in views if v.prepared is not None]
+    if not readable:
+        raise InputError(f"{item.image_path.parent}: none of the object's {len(item.views)} photos could be read")
+    side = min(v.prepared.side for v in readable)
+    for view in readable:
+        view.prepared = same_side(view.prepared, side)
+    return views, failures
+
+
+def fit_views(item: InputItem, predictor: Predictor, crop: CropMode, backdrop: Backdrop, resolution: Resolution,
+              say: Callable[[str], None], config: MultiviewConfig = MultiviewConfig()) -> tuple[ObjectFit,
+                                                                                               list[Failure]]:
+    """Read, predict and fit one multi-view object (its Failures: the photos left out unread)."""
+    views, failures = read_views(item, predictor.setup.image_size, crop, backdrop, resolution, say)
+    readable = [v.prepared for v in views if v.prepared is not None]
+    dec = predictor.predict([p.image for p in readable], [p.silhouette for p in readable])
+    decs = [dec.select(k) for k in range(len(readable))]
+    return fit_object(views, decs, predictor, config), failures
+
+
+def derender_views(item: InputItem, predictor: Predictor, out: Path, crop: CropMode, backdrop: Backdrop,
+                   resolution: Resolution, envs: dict[str, np.ndarray], export: ExportConfig,
+                   say: Callable[[str], None], size: ObjectSize | None = None) -> list[Failure]:
+    """De-render one multi-view object into out/<name>/ (at its catalogued size if known, as export_object);
+    returns the photos left out unread (the object is done).
+
+    Raises:
+        RadarError, ValueError, RuntimeError, OSError: the object could not be de-rendered.
+    """
+    fit, failures = fit_views(item, predictor, crop, backdrop, resolution, say)
+    for view in fit.views:
+        if view.prepared is not None and not view.used:
+            say(f"{view.source}: left out of {item.name}'s fit: {view.reason}")
+    first = fit.used[0]
+    folder = out / item.name
+    folder.mkdir(parents=True, exist_ok=True)
+    write_picture(folder / COVERAGE_FILE, fit.fused.coverage_image())
+    export_object(folder, InputItem(item.name, Path(first.source)), first.prepared, object_state(fit, predictor),
+                  predictor.setup, predictor.version, envs, export, "divided", predictor.pitch, first.report.record(),
+                  size=size, extra=views_record(fit))
+    return failures

@@ -1,0 +1,224 @@
+"""Fitting one object from its views: each view's own shape search, the side views chosen, one profile for them
+all (multiview.joint_shape), each view's lighting and material read at its fit (derender.refine.driver), each
+view's texture unwrapped over 360 deg (multiview.fuse), the turns registered (multiview.turns) and the albedo
+fused in the first used view's frame."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+import torch
+
+from radar_cli.config import CameraConfig
+from radar_cli.derender.multiview.fuse import FuseConfig, Fused, ViewTexture, fuse, match_exposure, unwrap_view
+from radar_cli.derender.multiview.joint_shape import Geometry, fit_jointly, profile_spread
+from radar_cli.derender.multiview.turns import TurnConfig, Turns, register_turns
+from radar_cli.derender.refine.driver import FIT_ERRORS, RefineReport, read_at_shape
+from radar_cli.derender.refine.fit_light import LightFitConfig
+from radar_cli.derender.refine.fit_shape import ShapeFit, ShapeFitConfig, fit_shape
+from radar_cli.derender.run.inputs import Prepared
+from radar_cli.derender.run.predictor import Predictor
+from radar_cli.derender.run.state import ObjectState, quantise
+from radar_cli.derender.run.upsample import PROFILE_ROWS, photo_tensors
+from radar_cli.model.outputs import Decomposition
+from radar_cli.sor.resample import smooth_rows
+from radar_cli.threads import torch_threads
+
+
+@dataclass(frozen=True)
+class MultiviewConfig:
+    """How an object's views are fitted together.
+
+    Attributes:
+        max_spread: a view whose own profile (radii over half-height) lies further than this (mean relative
+            difference) from the views' median is not a side view (a top view into the mouth, a detail) and is
+            left out.
+        max_outline_ratio: so is a view whose own fit draws its outline this many times worse than the views'
+            median (and at least 2 px).
+        shape, turns, fuse: the shape fit's, the turns' and the fusion's settings.
+    """
+
+    max_spread: float = 0.2
+    max_outline_ratio: float = 3.0
+    shape: ShapeFitConfig = ShapeFitConfig()
+    turns: TurnConfig = TurnConfig()
+    fuse: FuseConfig = FuseConfig()
+
+
+@dataclass
+class ViewFit:
+    """One view of the object and what became of it.
+
+    Attributes:
+        source: the photo. prepared: its crops (None: unreadable). used: part of the shape fit and the texture. reason: why not.
+        network: the network's reading of it (batch of one). own: its own shape fit (None if that failed). geometry: its pose and scale with the shared profile.
+        appearance: its Decomposition at that geometry (lighting, material). texture: its 360 deg albedo.
+        turn: degrees about the axis from the first used view; registered: the turn came from the textures.
+        agreement: the mean correlation with the views it overlaps at its turn.
+        outline_px: the shared profile's outline distance in this view (px at the output side).
+    """
+
+    source: str
+    prepared: Prepared | None
+    used: bool = False
+    reason: str = ""
+    network: Decomposition | None = None
+    own: ShapeFit | None = None
+    geometry: Geometry | None = None
+    appearance: Decomposition | None = None
+    report: RefineReport | None = None
+    texture: ViewTexture | None = None
+    turn: float = 0.0
+    registered: bool = False
+    agreement: float = float("nan")
+    outline_px: float = float("nan")
+
+    def record(self, share: float) -> dict:
+        """material.json's entry for this view."""
+        entry = {"source": self.source, "used": self.used, "reason": self.reason}
+        if self.used and self.geometry is not None:
+            pitch, roll, tx, ty = (round(float(v), 4) for v in self.geometry[2][0])
+            clean = lambda v: None if v != v else round(v, 4)  # noqa: E731
+            entry.update({"turn_deg": round(self.turn, 2), "turn_from": "texture" if self.registered else "prior",
+                          "agreement": clean(self.agreement), "pitch": pitch, "roll": roll, "tx": tx, "ty": ty,
+                          "height": round(float(self.geometry[1][0]), 4), "outline_px": clean(self.outline_px),
+                          "texel_share": round(share, 4)})
+        return entry
+
+
+@dataclass
+class ObjectFit:
+    """All views fitted: the views (first used one first) and the fused albedo."""
+
+    views: list[ViewFit]
+    fused: Fused | None = None
+    turns: Turns | None = None
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def used(self) -> list[ViewFit]:
+        return [v for v in self.views if v.used]
+
+
+def own_fits(views: list[ViewFit], decs: list[Decomposition], config: MultiviewConfig,
+             camera: CameraConfig) -> None:
+    """Each view's own shape fit (fit_shape, the network's pitch as its prior); a view whose fit fails is left
+    out."""
+    for view, dec in zip([v for v in views if v.prepared is not None], decs):
+        prep = view.prepared
+        view.network = dec
+        if prep.photo_silhouette is None:
+            view.reason = "no silhouette to fit (--crop none without --masks)"
+            continue
+        grey = prep.photo_image.astype(np.float32).mean(axis=2) / 255.0
+        try:
+            with torch_threads(1):
+                view.own = fit_shape(prep.photo_silhouette, grey, config.shape, camera, float(dec.pose[0, 0]))
+            view.used = True
+        except FIT_ERRORS as e:
+            view.reason = f"its shape fit failed ({type(e).__name__}: {e})"
+
+
+def choose_side_views(views: list[ViewFit], config: MultiviewConfig) -> None:
+    """Leave out the views whose own profile or outline disagrees with the others' (not seen from the side)."""
+    candidates = [v for v in views if v.used]
+    if len(candidates) < 3:
+        return  # two views cannot outvote each other
+    spread = profile_spread([v.own for v in candidates])
+    typical = float(np.median([v.own.outline_error for v in candidates]))
+    for view, s in zip(candidates, spread):
+        if s > config.max_spread:
+            view.used, view.reason = False, f"not a side view: its own profile differs from the others' by {s:.0%}"
+        elif view.own.outline_error > max(config.max_outline_ratio * typical, 2.0):
+            view.used, view.reason = False, (f"not a side view: its own outline fits {view.own.outline_error:.1f} px "
+                                             f"off (the views' median {typical:.1f} px)")
+
+
+def read_appearance(view: ViewFit, predictor: Predictor) -> None:
+    """A view's lighting and material at its geometry: the networks re-read there and the light fitted
+    (derender.refine.driver.read_at_shape; `--refine shape`: not fitted; `--refine none`: the network's first
+    reading, the geometry replaced)."""
+    radius, height, pose = view.geometry
+    report = RefineReport("refined", "", view.prepared.side, view.own.pitch_cue, (view.outline_px, float("nan")))
+    if predictor.refine == "none":
+        view.appearance = dataclasses.replace(view.network, radius=radius, height=height, pose=pose)
+        view.report = report
+        return
+    image = torch.from_numpy(view.prepared.image).permute(2, 0, 1)[None].float() / 255.0
+    light = LightFitConfig() if predictor.refine == "full" else None
+    with torch_threads(1):
+        appearance, view.report = read_at_shape(
+            predictor.model, image.to(predictor.device), view.network.to(predictor.device), view.geometry,
+            view.prepared.photo_image, view.prepared.photo_silhouette, predictor.setup.camera, light,
+            predictor.reader, report)
+    view.appearance = appearance.to("cpu")
+
+
+def unwrap_texture(view: ViewFit, predictor: Predictor) -> ViewTexture:
+    """A view's photograph unwrapped over 360 deg at its geometry and divided by its shading."""
+    a = view.appearance
+    photo, coverage = photo_tensors(view.prepared)
+    if coverage is None:
+        coverage = torch.ones_like(photo[:, :1])
+    radius = smooth_rows(a.radius.float(), max(PROFILE_ROWS, a.radius.shape[1]))
+    render = ObjectState.export_render(predictor.setup.render)
+    return unwrap_view(photo, coverage, radius, a.height.float(), a.pose.float(), a.env.float(), a.alpha.float(),
+                       a.rho.float(), view.prepared.side, render, predictor.setup.camera)
+
+
+def fit_object(views: list[ViewFit], decs: list[Decomposition], predictor: Predictor,
+               config: MultiviewConfig = MultiviewConfig()) -> ObjectFit:
+    """Fit an object from its views (the readable ones prepared at the same output side N) and the network's
+    reading of each readable one (decs, in order).
+
+    Raises:
+        ValueError: no view could be fitted.
+    """
+    own_fits(views, decs, config, predictor.setup.camera)
+    choose_side_views(views, config)
+    return fit_chosen(views, predictor, config)
+
+
+def fit_chosen(views: list[ViewFit], predictor: Predictor, config: MultiviewConfig = MultiviewConfig(),
+               turns: list[float] | None = None) -> ObjectFit:
+    """The shared profile, appearances, turns (registered, or as given per used view) and fused albedo of the
+    views marked used (own fits done)."""
+    used = [v for v in views if v.used]
+    if not used:
+        raise ValueError("no view could be fitted: " + "; ".join(f"{v.source}: {v.reason}" for v in views))
+    geometries, errors = fit_jointly([v.prepared.photo_silhouette for v in used], [v.own for v in used],
+                                     config.shape, predictor.setup.camera)
+    for view, geometry, error in zip(used, geometries, errors):
+        view.geometry, view.outline_px = geometry, error
+        read_appearance(view, predictor)
+        view.texture = unwrap_texture(view, predictor)
+    if turns is None:
+        turns = register_turns([v.texture for v in used], config.turns)
+    else:
+        turns = Turns(tuple(turns), (False,) * len(used), (float("nan"),) * len(used))
+    for view, turn, registered, agreement in zip(used, turns.degrees, turns.registered, turns.agreement):
+        view.turn, view.registered, view.agreement = turn, registered, agreement
+    turned = match_exposure([v.texture.turned(v.turn) for v in used], config.fuse)
+    return ObjectFit(views, fuse(turned, config.fuse), turns)
+
+
+def object_state(fit: ObjectFit, predictor: Predictor) -> ObjectState:
+    """The exported object: the first used view's geometry, lighting and material, the fused albedo."""
+    first = fit.used[0].appearance
+    setup = predictor.setup
+    radius = smooth_rows(first.radius.float(), max(PROFILE_ROWS, first.radius.shape[1]))
+    state = ObjectState.from_decomposition(dataclasses.replace(first, radius=radius), setup.render, setup.camera)
+    return dataclasses.replace(state, albedo=quantise(fit.fused.albedo, setup.render.gamma))
+
+
+def views_record(fit: ObjectFit) -> dict:
+    """material.json's `views` (every photo: used or left out and why, turn, pose) and `coverage`."""
+    shares = {}
+    if fit.fused is not None:
+        total = fit.fused.share.sum(dim=0).sum()
+        for view, share in zip(fit.used, fit.fused.share):
+            shares[id(view)] = float(share.sum() / max(float(total), 1e-12))
+    seen = None if fit.fused is None else round(fit.fused.seen_fraction(), 4)
+    return {"views": [v.record(shares.get(id(v), 0.0)) for v in fit.views], "seen_fraction": seen}

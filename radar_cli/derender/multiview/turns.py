@@ -1,0 +1,187 @@
+"""The turn of each view about the axis relative to the first, found from the photographs: the views' textures
+unwrapped over 360 deg (multiview.fuse.unwrap_view) are compared where two views see the same surface, by
+normalised cross-correlation of their detail along the angle (each row's slow changes, the shading the fit did not
+explain and the painted horizontal bands, taken out), at every turn between them. The turns that agree best over
+all pairs are chosen, near a prior of equal steps (a museum's A, A/B, B, B/A views: 90 deg) that only ranks
+near-ties: a view whose texture overlaps none of the others' keeps its step."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+
+from radar_cli.derender.multiview.fuse import ViewTexture
+
+
+SPREAD_TIE_BREAK = 1e-6  # per degree of the smallest gap between views: decides only between equal scores
+
+
+@dataclass(frozen=True)
+class TurnConfig:
+    """How the turns are registered.
+
+    Attributes:
+        step_deg: the prior's step between views (each view starts at a distinct multiple of it).
+        reach_deg: each turn is searched within this of its step.
+        prior_weight: the score lost by a turn reach_deg away from its step (the correlations are 0..1 per pair).
+        rows: rows of the low-resolution maps compared (their columns are whole degrees, 360).
+        detail_sigma_deg, fine_sigma_deg: the detail compared is the texture blurred along the angle by a Gaussian
+            of the fine width less its blur by the other (a band: the shading and the bands are slower, a painted
+            frieze's repeats are finer and would match at every repeat).
+        seen: texels a view sees at a cosine below this are left out of the comparison.
+        full_overlap: overlaps of at least this many texels count fully; smaller ones in proportion.
+        rounds: rounds of coordinate ascent over the views' turns.
+    """
+
+    step_deg: float = 90.0
+    reach_deg: float = 30.0
+    prior_weight: float = 0.05
+    rows: int = 64
+    detail_sigma_deg: float = 12.0
+    fine_sigma_deg: float = 2.0
+    seen: float = 0.3
+    full_overlap: int = 3000
+    rounds: int = 3
+
+
+@dataclass(frozen=True)
+class Turns:
+    """The registered turns.
+
+    Attributes:
+        degrees: per view, its turn relative to the first (0 for the first), in [0, 360).
+        registered: per view, whether its texture overlapped another view's (False: the prior's step kept).
+        agreement: per view, the mean correlation with the views it overlaps at the chosen turns (NaN: none).
+    """
+
+    degrees: tuple[float, ...]
+    registered: tuple[bool, ...]
+    agreement: tuple[float, ...]
+
+
+def _circular_blur(x: np.ndarray, sigma: float) -> np.ndarray:
+    """R x 360 blurred along the angle (wrapping round) by a Gaussian of sigma columns."""
+    radius = int(math.ceil(3 * sigma))
+    taps = np.exp(-0.5 * (np.arange(-radius, radius + 1) / sigma) ** 2)
+    taps /= taps.sum()
+    padded = np.concatenate([x[:, -radius:], x, x[:, :radius]], axis=1)
+    return np.stack([np.convolve(row, taps, mode="valid") for row in padded])
+
+
+def detail_map(view: ViewTexture, config: TurnConfig) -> tuple[np.ndarray, np.ndarray]:
+    """(R x 360 detail, R x 360 bool seen) of a view's texture: the grey albedo at whole degrees less its blur along
+    the angle (a weighted blur over the seen texels only)."""
+    grey = view.albedo.mean(1, keepdim=True) ** (1 / 2.2)
+    small = F.interpolate(torch.cat([grey, view.weight], 1), size=(config.rows, 360), mode="area")[0].double().numpy()
+    seen = small[1] > config.seen
+    value = np.where(seen, small[0], 0.0)
+    mask = seen.astype(np.float64)
+    fine, coarse = (_blurred(value, mask, sigma) for sigma in (config.fine_sigma_deg, config.detail_sigma_deg))
+    return np.where(seen, fine - coarse, 0.0), seen
+
+
+def _blurred(value: np.ndarray, mask: np.ndarray, sigma: float) -> np.ndarray:
+    """The masked values' normalised blur along the angle (the value itself where sigma is 0)."""
+    if sigma <= 0:
+        return value
+    return _circular_blur(value * mask, sigma) / np.maximum(_circular_blur(mask, sigma), 1e-6)
+
+
+def correlation(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray],
+                config: TurnConfig) -> tuple[np.ndarray, np.ndarray]:
+    """(360 correlations, 360 overlap weights in [0, 1]) of view a's detail with view b's turned by d degrees
+    (b's column c moved to c + d), for d = 0..359: a sees at its angle phi what b sees at phi - d, i.e. b's turn
+    is a's plus d."""
+    (da, sa), (db, sb) = a, b
+    ncc, weight = np.zeros(360), np.zeros(360)
+    for d in range(360):
+        both = sa & np.roll(sb, d, axis=1)
+        n = int(both.sum())
+        if n < 20:
+            continue
+        x, y = da[both], np.roll(db, d, axis=1)[both]
+        x, y = x - x.mean(), y - y.mean()
+        ncc[d] = float((x * y).sum() / max(math.sqrt(float((x * x).sum() * (y * y).sum())), 1e-12))
+        weight[d] = min(1.0, n / config.full_overlap)
+    return ncc, weight
+
+
+def _score_at(k: int, theta: np.ndarray, curves: dict, count: int) -> np.ndarray:
+    """360 scores of view k's turn at each whole degree, the others' held: its pairs' weighted correlations."""
+    total = np.zeros(360)
+    for j in range(count):
+        if j == k:
+            continue
+        ncc, weight = curves[(j, k)]  # indexed by theta_k - theta_j
+        shift = int(round(theta[j])) % 360
+        total += np.roll(ncc * weight, shift)
+    return total
+
+
+def _prior(slot: float, config: TurnConfig) -> np.ndarray:
+    """360 prior penalties of a view's turn near `slot` (inf beyond reach_deg)."""
+    off = (np.arange(360) - slot + 180) % 360 - 180
+    return np.where(np.abs(off) <= config.reach_deg, config.prior_weight * (off / config.reach_deg) ** 2, np.inf)
+
+
+def _ascend(slots: tuple[float, ...], curves: dict, config: TurnConfig) -> tuple[np.ndarray, float]:
+    """Coordinate ascent from the slots: (the turns, their total score)."""
+    count = len(slots)
+    theta = np.array(slots, np.float64)
+    for _ in range(config.rounds):
+        for k in range(1, count):
+            theta[k] = float(np.argmax(_score_at(k, theta, curves, count) - _prior(slots[k], config)))
+    total = sum(_score_at(k, theta, curves, count)[int(theta[k]) % 360] - _prior(slots[k], config)[int(theta[k])]
+                for k in range(1, count))
+    for k in range(1, count):  # sub-degree: a parabola through the peak and its neighbours
+        s = _score_at(k, theta, curves, count)
+        c = int(theta[k]) % 360
+        left, mid, right = s[c - 1], s[c], s[(c + 1) % 360]
+        bend = left - 2 * mid + right
+        if bend < 0:
+            theta[k] = (theta[k] + float(np.clip(0.5 * (left - right) / bend, -0.5, 0.5))) % 360
+    return theta, float(total)
+
+
+def _smallest_gap(slots: tuple[float, ...]) -> float:
+    """The smallest angle between two of the slots round the circle (degrees)."""
+    ordered = sorted(s % 360 for s in slots)
+    return min((b - a) % 360 or 360.0 for a, b in zip(ordered, ordered[1:] + ordered[:1]))
+
+
+def register_turns(views: list[ViewTexture], config: TurnConfig = TurnConfig()) -> Turns:
+    """The turns of V views (each ViewTexture in its own frame) relative to the first: every assignment of the
+    views to distinct steps of the prior (or steps reused, with more views than steps) is polished by coordinate
+    ascent and the best total agreement kept."""
+    count = len(views)
+    details = [detail_map(v, config) for v in views]
+    curves = {}
+    for i, j in itertools.combinations(range(count), 2):
+        ncc, weight = correlation(details[i], details[j], config)
+        curves[(i, j)] = (ncc, weight)
+        curves[(j, i)] = (np.roll(ncc[::-1], 1), np.roll(weight[::-1], 1))  # d -> -d
+    steps = max(1, int(round(360 / config.step_deg)))
+    others = range(1, steps)
+    choices = (itertools.permutations(others, count - 1) if count - 1 <= len(others)
+               else itertools.product(range(steps), repeat=count - 1))
+    best = (np.zeros(count), -np.inf)
+    for choice in choices:
+        slots = (0.0, *(c * config.step_deg for c in choice))
+        theta, total = _ascend(slots, curves, config)
+        total += SPREAD_TIE_BREAK * _smallest_gap(slots)  # on a tie (no overlaps) the views spread round evenly
+        if total > best[1]:
+            best = (theta, total)
+    theta = best[0]
+    registered, agreement = [True], [float("nan")]
+    for k in range(1, count):
+        pairs = [(curves[(j, k)][0][int(round(theta[k] - theta[j])) % 360],
+                  curves[(j, k)][1][int(round(theta[k] - theta[j])) % 360]) for j in range(count) if j != k]
+        used = [c for c, w in pairs if w > 0]
+        registered.append(bool(used))
+        agreement.append(float(np.mean(used)) if used else float("nan"))
+    return Turns(tuple(float(t % 360) for t in theta), tuple(registered), tuple(agreement))

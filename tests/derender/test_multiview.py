@@ -1,0 +1,158 @@
+"""Objects photographed from several sides: the turns between views registered from their textures, the albedo
+fused over the full turn (a synthetic vase with a texture that differs all round), and a multi-view folder with
+an unreadable photo de-rendered end to end."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+import torch.nn.functional as F
+
+from radar_cli.config import CameraConfig, RenderConfig
+from radar_cli.derender.export.object_folder import ExportConfig
+from radar_cli.derender.multiview.fuse import fuse, match_exposure, unwrap_view
+from radar_cli.derender.multiview.turns import register_turns
+from radar_cli.derender.run.batch import DerenderOptions, derender
+from radar_cli.derender.run.inputs import collect_inputs
+from radar_cli.derender.run.predictor import Predictor
+from radar_cli.render.scene import render_view
+from radar_cli.render.texture import front_third, full_from_front
+
+from .conftest import write_photo
+
+TURNS = (0.0, 87.0, 183.0, 272.0)  # near, not at, the usual 90 deg steps
+ROWS, SIZE = 96, 192
+RENDER = RenderConfig(image_size=SIZE, tex_height=ROWS, tex_width=ROWS, shading_height=16, shading_width=16)
+CAMERA = CameraConfig()
+
+
+def vase() -> tuple[torch.Tensor, ...]:
+    """A vase (radius 1 x 32, height, pose with some pitch), a soft light from the upper left, and an albedo
+    1 x 3 x ROWS x 3 ROWS of coloured blobs that differs all the way round (no two sides alike)."""
+    y = torch.linspace(1, -1, 32)
+    radius = (0.45 + 0.18 * torch.sin(2.2 * y + 0.5))[None]
+    height, pose = torch.tensor([0.75]), torch.tensor([[8.0, 0.0, 0.0, 0.0]])
+    gen = torch.Generator().manual_seed(3)
+    noise = torch.rand(1, 3, 8, 24, generator=gen)
+    wrapped = torch.cat([noise[..., -2:], noise, noise[..., :2]], -1)  # smooth across the seam at 180 deg
+    albedo = F.interpolate(wrapped, size=(ROWS, 3 * ROWS + ROWS // 3), mode="bicubic", align_corners=False)
+    albedo = albedo[..., ROWS // 6 : ROWS // 6 + 3 * ROWS].clamp(0.05, 0.95)
+    env = torch.full((1, 16, 48), 0.4)
+    env[:, 3:6, 14:20] = 4.0
+    return radius, height, pose, albedo, env, torch.tensor([20.0]), torch.tensor([0.1])
+
+
+def views_of(truth: tuple[torch.Tensor, ...]):
+    """Each turn's photo unwrapped at the true shape, pose and light (the fit's part is tested elsewhere)."""
+    radius, height, pose, albedo, env, alpha, rho = truth
+    views = []
+    for turn in TURNS:
+        # the view turned by `turn` sees the object's angle `turn` in front: the albedo spun back by it
+        image, coverage = render_view(radius, height, pose, albedo, env, alpha, rho, SIZE, -turn, RENDER, CAMERA)
+        views.append(unwrap_view(image, coverage, radius, height, pose, env, alpha, rho, ROWS, RENDER, CAMERA))
+    return views
+
+
+@pytest.fixture(scope="module")
+def synthetic():
+    truth = vase()
+    return truth, views_of(truth)
+
+
+def angle_error(a: float, b: float) -> float:
+    return abs((a - b + 180) % 360 - 180)
+
+
+def test_turns_recovered_within_3_degrees(synthetic) -> None:
+    _, views = synthetic
+    turns = register_turns(views)
+    assert all(turns.registered)
+    errors = [angle_error(found, true) for found, true in zip(turns.degrees, TURNS)]
+    assert max(errors) <= 3.0, (turns.degrees, errors)
+
+
+def side_errors(albedo: torch.Tensor, truth: torch.Tensor) -> list[float]:
+    """Mean absolute error (display levels) over the middle rows in each quarter of the turn: back-left, left,
+    front... as 4 columns blocks centred on -180, -90, 0 and 90 deg."""
+    shift = albedo.shape[-1] // 8
+    a, t = (torch.roll(x, shift, -1)[..., ROWS // 5 : -ROWS // 5, :] ** (1 / 2.2) for x in (albedo, truth))
+    return [float((a - t).abs()[..., k * (a.shape[-1] // 4) : (k + 1) * (a.shape[-1] // 4)].mean()) for k in range(4)]
+
+
+def test_fused_texture_matches_on_every_side_and_the_mirrored_one_does_not(synthetic) -> None:
+    truth, views = synthetic
+    albedo = truth[3]
+    turns = register_turns(views)
+    fused = fuse(match_exposure([v.turned(t) for v, t in zip(views, turns.degrees)]))
+    assert fused.seen_fraction() > 0.95
+    fused_errors = side_errors(fused.albedo, albedo)
+    assert max(fused_errors) < 0.05, fused_errors
+    single = full_from_front(front_third(views[0].albedo))  # today's single view: the front mirrored round
+    single_errors = side_errors(single, albedo)
+    assert single_errors[0] > 3 * max(fused_errors), (single_errors, fused_errors)  # the back is the front mirrored
+    assert single_errors[0] > 0.08
+
+
+def test_coverage_shows_what_no_view_sees(synthetic) -> None:
+    _, views = synthetic
+    front_back = [views[0].turned(TURNS[0]), views[2].turned(TURNS[2])]
+    fused = fuse(front_back)
+    image = fused.coverage_image()
+    assert image.shape == (ROWS, 3 * ROWS, 3)
+    black = image.sum(-1) == 0
+    assert 0.1 < black.mean() < 0.5  # the two sides neither view sees are black (mirrored there)
+    assert not black[:, 3 * ROWS // 2].any()  # the front is seen
+
+
+def test_subfolders_of_two_or_more_photos_are_objects(tmp_path: Path) -> None:
+    write_photo(tmp_path / "in" / "single.png", 1)
+    write_photo(tmp_path / "in" / "one" / "only.png", 2)
+    for k, view in enumerate(("back", "front", "side")):
+        write_photo(tmp_path / "in" / "pot" / f"{view}.png", 3 + k)
+    items, failures = collect_inputs([tmp_path / "in"])
+    assert not failures
+    by_name = {i.name: i for i in items}
+    assert set(by_name) == {"single", "only", "pot"}
+    assert not by_name["single"].multiview and not by_name["only"].multiview
+    assert [p.stem for p in by_name["pot"].views] == ["front", "back", "side"]  # front first
+
+
+def test_a_multiview_folder_with_an_unreadable_photo_goes_on(tmp_path: Path, predictor: Predictor) -> None:
+    for k, view in enumerate(("front", "back", "side")):
+        write_photo(tmp_path / "in" / "pot" / f"{view}.png", 3, (80, 80))
+    (tmp_path / "in" / "pot" / "broken.jpg").write_bytes(b"not a jpeg")
+    lines: list[str] = []
+    out = tmp_path / "out"
+    summary = derender([tmp_path / "in"], predictor, DerenderOptions(out=out, export=ExportConfig(views=2,
+                                                                                                  view_size=32)),
+                       say=lines.append)
+    assert summary.done == ["pot"]
+    assert [Path(f.source).name for f in summary.failures] == ["broken.jpg"]
+    assert sum("broken.jpg" in line for line in lines) == 1
+    record = json.loads((out / "pot" / "material.json").read_text())
+    views = {Path(v["source"]).name: v for v in record["views"]}
+    assert not views["broken.jpg"]["used"] and "unreadable" in views["broken.jpg"]["reason"]
+    assert sum(v["used"] for v in views.values()) >= 2
+    assert (out / "pot" / "coverage.png").is_file()
+
+
+@pytest.mark.slow  # about 35 s on a busy 2-core machine
+def test_eval_views_scores_every_side_view(tmp_path: Path, predictor: Predictor) -> None:
+    from radar_cli.evaluate.held_out import evaluate_views, summary_line
+
+    for k, view in enumerate(("front", "back", "side")):
+        write_photo(tmp_path / "in" / "pot" / f"{view}.png", 3, (80, 80))
+    write_photo(tmp_path / "in" / "pair" / "front.png", 4, (80, 80))  # two views: too few to leave one out
+    write_photo(tmp_path / "in" / "pair" / "back.png", 5, (80, 80))
+    lines: list[str] = []
+    rows = evaluate_views(tmp_path / "in", tmp_path / "out", predictor, 512, lines.append)
+    assert sorted(r.view for r in rows) == ["back", "front", "side"]
+    assert all(r.object == "pot" and np.isfinite(r.multi_psnr) and np.isfinite(r.single_psnr) for r in rows)
+    assert any("pair" in line and "not evaluated" in line for line in lines)
+    assert (tmp_path / "out" / "held_out.csv").read_text().count("\n") == 4
+    assert (tmp_path / "out" / "pot.png").is_file()
+    assert "3 held-out views of 1 objects" in summary_line(rows)
