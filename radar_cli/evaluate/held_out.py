@@ -21,15 +21,20 @@ import torch
 from radar_cli.derender.export.maps import write_picture
 from radar_cli.derender.export.quality import psnr
 from radar_cli.derender.multiview.driver import read_views
-from radar_cli.derender.multiview.fit import MultiviewConfig, ViewFit, choose_side_views, fit_chosen, own_fits
+from radar_cli.derender.multiview.fit import (
+    MultiviewConfig,
+    ViewFit,
+    choose_side_views,
+    exported_solid,
+    fit_chosen,
+    own_fits,
+)
 from radar_cli.derender.run.inputs import Resolution, collect_inputs
 from radar_cli.derender.run.predictor import Predictor
 from radar_cli.derender.run.state import ObjectState
-from radar_cli.derender.run.upsample import PROFILE_ROWS
 from radar_cli.fileio import to_uint8, write_text
 from radar_cli.render.scene import render_view, rotate_full_map
 from radar_cli.render.texture import front_third, full_from_front
-from radar_cli.sor.resample import smooth_rows
 
 MIN_SIDE_VIEWS = 3
 PICTURE_SIDE = 256
@@ -63,12 +68,11 @@ def masked_ssim(a: np.ndarray, b: np.ndarray, mask: np.ndarray, sigma: float = 1
 
 def _draw(view: ViewFit, albedo: torch.Tensor, turn: float, predictor: Predictor) -> np.ndarray:
     """The view drawn at its own shape, pose and lighting with an object-frame albedo, N x N x 3 uint8."""
-    a = view.appearance
-    radius = smooth_rows(a.radius.float(), max(PROFILE_ROWS, a.radius.shape[1]))
+    a = view.looks
     render = ObjectState.export_render(predictor.setup.render)
+    material = a.material.map(torch.Tensor.float).with_albedo(albedo)
     with torch.no_grad():
-        image, _ = render_view(radius, a.height.float(), a.pose.float(), albedo, a.env.float(), a.alpha.float(),
-                               a.rho.float(), view.prepared.side, -turn, render, predictor.setup.camera)
+        image, _ = render_view(exported_solid(a), material, view.crops.side, -turn, render, predictor.setup.camera)
     return to_uint8(image[0].permute(1, 2, 0).numpy())
 
 
@@ -88,9 +92,9 @@ def leave_out(views: list[ViewFit], held: ViewFit, full: dict[int, tuple], predi
     held.used = True
     turn, held.appearance = full[id(held)][0] - reference, full[id(held)][1]
     nearest = min(others, key=lambda v: _angle(v.turn, turn))
-    single = rotate_full_map(full_from_front(front_third(nearest.texture.albedo)), nearest.turn)
-    photo, mask = held.prepared.photo_image, held.prepared.photo_silhouette
-    multi_image, single_image = (_draw(held, albedo, turn, predictor) for albedo in (fit.fused.albedo, single))
+    single = rotate_full_map(full_from_front(front_third(nearest.tex.albedo)), nearest.turn)
+    photo, mask = held.photo, held.mask
+    multi_image, single_image = (_draw(held, albedo, turn, predictor) for albedo in (fit.fused_map.albedo, single))
     score = HeldOut("", Path(held.source).stem, round(turn % 360, 2), Path(nearest.source).stem,
                     psnr(multi_image[mask], photo[mask]), masked_ssim(multi_image, photo, mask),
                     psnr(single_image[mask], photo[mask]), masked_ssim(single_image, photo, mask))
@@ -103,7 +107,7 @@ def evaluate_object(item, predictor: Predictor, resolution: Resolution, say: Cal
     than MIN_SIDE_VIEWS side views."""
     views, _ = read_views(item, predictor.setup.image_size, "auto", "white", resolution, say)
     readable = [v for v in views if v.prepared is not None]
-    dec = predictor.predict([v.prepared.image for v in readable], [v.prepared.silhouette for v in readable])
+    dec = predictor.predict([v.crops.image for v in readable], [v.crops.silhouette for v in readable])
     own_fits(views, [dec.select(k) for k in range(len(readable))], config, predictor.setup.camera)
     choose_side_views(views, config)
     side = [v for v in views if v.used]

@@ -19,8 +19,10 @@ from radar_cli.derender.multiview.turns import register_turns
 from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.run.inputs import collect_inputs
 from radar_cli.derender.run.predictor import Predictor
+from radar_cli.render.material import Material
 from radar_cli.render.scene import render_view
 from radar_cli.render.texture import front_third, full_from_front
+from radar_cli.sor.solid import Solid
 
 from .conftest import write_photo
 
@@ -52,8 +54,9 @@ def views_of(truth: tuple[torch.Tensor, ...]):
     views = []
     for turn in TURNS:
         # the view turned by `turn` sees the object's angle `turn` in front: the albedo spun back by it
-        image, coverage = render_view(radius, height, pose, albedo, env, alpha, rho, SIZE, -turn, RENDER, CAMERA)
-        views.append(unwrap_view(image, coverage, radius, height, pose, env, alpha, rho, ROWS, RENDER, CAMERA))
+        solid, material = Solid(radius, height, pose), Material(albedo, env, alpha, rho)
+        image, coverage = render_view(solid, material, SIZE, -turn, RENDER, CAMERA)
+        views.append(unwrap_view(image, coverage, solid, material, ROWS, RENDER, CAMERA))
     return views
 
 
@@ -122,7 +125,7 @@ def test_subfolders_of_two_or_more_photos_are_objects(tmp_path: Path) -> None:
 
 
 def test_a_multiview_folder_with_an_unreadable_photo_goes_on(tmp_path: Path, predictor: Predictor) -> None:
-    for k, view in enumerate(("front", "back", "side")):
+    for view in ("front", "back", "side"):
         write_photo(tmp_path / "in" / "pot" / f"{view}.png", 3, (80, 80))
     (tmp_path / "in" / "pot" / "broken.jpg").write_bytes(b"not a jpeg")
     lines: list[str] = []
@@ -144,7 +147,7 @@ def test_a_multiview_folder_with_an_unreadable_photo_goes_on(tmp_path: Path, pre
 def test_eval_views_scores_every_side_view(tmp_path: Path, predictor: Predictor) -> None:
     from radar_cli.evaluate.held_out import evaluate_views, summary_line
 
-    for k, view in enumerate(("front", "back", "side")):
+    for view in ("front", "back", "side"):
         write_photo(tmp_path / "in" / "pot" / f"{view}.png", 3, (80, 80))
     write_photo(tmp_path / "in" / "pair" / "front.png", 4, (80, 80))  # two views: too few to leave one out
     write_photo(tmp_path / "in" / "pair" / "back.png", 5, (80, 80))

@@ -14,8 +14,17 @@ import numpy as np
 from radar_cli.derender.export.maps import write_picture
 from radar_cli.derender.export.object_folder import ExportConfig, export_object
 from radar_cli.derender.multiview.fit import MultiviewConfig, ObjectFit, ViewFit, fit_object, object_state, views_record
-from radar_cli.derender.run.inputs import (Backdrop, CropMode, Failure, InputItem, Prepared, Resolution, prepare,
-                                           resize_image, resize_mask)
+from radar_cli.derender.run.inputs import (
+    Backdrop,
+    CropMode,
+    Failure,
+    InputItem,
+    Prepared,
+    Resolution,
+    prepare,
+    resize_image,
+    resize_mask,
+)
 from radar_cli.derender.run.predictor import Predictor
 from radar_cli.errors import InputError, RadarError
 from radar_cli.results import COVERAGE_FILE
@@ -26,10 +35,11 @@ def same_side(prepared: Prepared, side: int) -> Prepared:
     """A view's output-side crops at `side` (views cropped from photos of different sizes)."""
     if prepared.side == side:
         return prepared
-    resized = {name: resize_image(getattr(prepared, name), side) for name in ("photo_image", "photo_scene")}
-    masks = {name: None if getattr(prepared, name) is None else resize_mask(getattr(prepared, name), side)
-             for name in ("photo_silhouette", "appendages")}
-    return dataclasses.replace(prepared, **resized, **masks)
+    mask = lambda m: None if m is None else resize_mask(m, side)  # noqa: E731
+    image = lambda m: None if m is None else resize_image(m, side)  # noqa: E731
+    return dataclasses.replace(prepared, photo_image=image(prepared.photo_image),
+                               photo_scene=image(prepared.photo_scene),
+                               photo_silhouette=mask(prepared.photo_silhouette), appendages=mask(prepared.appendages))
 
 
 def read_views(item: InputItem, size: int, crop: CropMode, backdrop: Backdrop, resolution: Resolution,
@@ -49,9 +59,9 @@ def read_views(item: InputItem, size: int, crop: CropMode, backdrop: Backdrop, r
     readable = [v for v in views if v.prepared is not None]
     if not readable:
         raise InputError(f"{item.image_path.parent}: none of the object's {len(item.views)} photos could be read")
-    side = min(v.prepared.side for v in readable)
+    side = min(v.crops.side for v in readable)
     for view in readable:
-        view.prepared = same_side(view.prepared, side)
+        view.prepared = same_side(view.crops, side)
     return views, failures
 
 
@@ -60,7 +70,7 @@ def fit_views(item: InputItem, predictor: Predictor, crop: CropMode, backdrop: B
                                                                                                list[Failure]]:
     """Read, predict and fit one multi-view object (its Failures: the photos left out unread)."""
     views, failures = read_views(item, predictor.setup.image_size, crop, backdrop, resolution, say)
-    readable = [v.prepared for v in views if v.prepared is not None]
+    readable = [v.crops for v in views if v.prepared is not None]
     dec = predictor.predict([p.image for p in readable], [p.silhouette for p in readable])
     decs = [dec.select(k) for k in range(len(readable))]
     return fit_object(views, decs, predictor, config), failures
@@ -82,8 +92,9 @@ def derender_views(item: InputItem, predictor: Predictor, out: Path, crop: CropM
     first = fit.used[0]
     folder = out / item.name
     folder.mkdir(parents=True, exist_ok=True)
-    write_picture(folder / COVERAGE_FILE, fit.fused.coverage_image())
-    export_object(folder, InputItem(item.name, Path(first.source)), first.prepared, object_state(fit, predictor),
+    write_picture(folder / COVERAGE_FILE, fit.fused_map.coverage_image())
+    assert first.report is not None
+    export_object(folder, InputItem(item.name, Path(first.source)), first.crops, object_state(fit, predictor),
                   predictor.setup, predictor.version, envs, export, "divided", predictor.pitch, first.report.record(),
                   size=size, extra=views_record(fit))
     return failures

@@ -24,6 +24,7 @@ from radar_cli.derender.run.state import ObjectState, quantise
 from radar_cli.derender.run.upsample import PROFILE_ROWS, photo_tensors
 from radar_cli.model.outputs import Decomposition
 from radar_cli.sor.resample import smooth_rows
+from radar_cli.sor.solid import Solid
 from radar_cli.threads import torch_threads
 
 
@@ -52,8 +53,10 @@ class ViewFit:
     """One view of the object and what became of it.
 
     Attributes:
-        source: the photo. prepared: its crops (None: unreadable). used: part of the shape fit and the texture. reason: why not.
-        network: the network's reading of it (batch of one). own: its own shape fit (None if that failed). geometry: its pose and scale with the shared profile.
+        source: the photo. prepared: its crops (None: unreadable). used: part of the shape fit and the texture.
+        reason: why not.
+        network: the network's reading of it (batch of one). own: its own shape fit (None if that failed).
+        geometry: its solid: the shared profile at its scale, its pose.
         appearance: its Decomposition at that geometry (lighting, material). texture: its 360 deg albedo.
         turn: degrees about the axis from the first used view; registered: the turn came from the textures.
         agreement: the mean correlation with the views it overlaps at its turn.
@@ -75,15 +78,52 @@ class ViewFit:
     agreement: float = float("nan")
     outline_px: float = float("nan")
 
+    @property
+    def crops(self) -> Prepared:
+        assert self.prepared is not None, f"{self.source}: not read"
+        return self.prepared
+
+    @property
+    def photo(self) -> np.ndarray:
+        """N x N x 3 uint8 crop at the output side."""
+        assert self.crops.photo_image is not None
+        return self.crops.photo_image
+
+    @property
+    def mask(self) -> np.ndarray:
+        """N x N bool silhouette at the output side."""
+        assert self.crops.photo_silhouette is not None, f"{self.source}: no silhouette"
+        return self.crops.photo_silhouette
+
+    @property
+    def own_fit(self) -> ShapeFit:
+        assert self.own is not None, f"{self.source}: not fitted"
+        return self.own
+
+    @property
+    def solid(self) -> Solid:
+        assert self.geometry is not None, f"{self.source}: not fitted"
+        return self.geometry
+
+    @property
+    def looks(self) -> Decomposition:
+        assert self.appearance is not None, f"{self.source}: its appearance not read"
+        return self.appearance
+
+    @property
+    def tex(self) -> ViewTexture:
+        assert self.texture is not None, f"{self.source}: not unwrapped"
+        return self.texture
+
     def record(self, share: float) -> dict:
         """material.json's entry for this view."""
         entry = {"source": self.source, "used": self.used, "reason": self.reason}
         if self.used and self.geometry is not None:
-            pitch, roll, tx, ty = (round(float(v), 4) for v in self.geometry[2][0])
+            pitch, roll, tx, ty = (round(float(v), 4) for v in self.geometry.pose[0])
             clean = lambda v: None if v != v else round(v, 4)  # noqa: E731
             entry.update({"turn_deg": round(self.turn, 2), "turn_from": "texture" if self.registered else "prior",
                           "agreement": clean(self.agreement), "pitch": pitch, "roll": roll, "tx": tx, "ty": ty,
-                          "height": round(float(self.geometry[1][0]), 4), "outline_px": clean(self.outline_px),
+                          "height": round(float(self.geometry.height[0]), 4), "outline_px": clean(self.outline_px),
                           "texel_share": round(share, 4)})
         return entry
 
@@ -101,21 +141,25 @@ class ObjectFit:
     def used(self) -> list[ViewFit]:
         return [v for v in self.views if v.used]
 
+    @property
+    def fused_map(self) -> Fused:
+        assert self.fused is not None
+        return self.fused
+
 
 def own_fits(views: list[ViewFit], decs: list[Decomposition], config: MultiviewConfig,
              camera: CameraConfig) -> None:
     """Each view's own shape fit (fit_shape, the network's pitch as its prior); a view whose fit fails is left
     out."""
     for view, dec in zip([v for v in views if v.prepared is not None], decs):
-        prep = view.prepared
         view.network = dec
-        if prep.photo_silhouette is None:
+        if view.crops.photo_silhouette is None:
             view.reason = "no silhouette to fit (--crop none without --masks)"
             continue
-        grey = prep.photo_image.astype(np.float32).mean(axis=2) / 255.0
+        grey = view.photo.astype(np.float32).mean(axis=2) / 255.0
         try:
             with torch_threads(1):
-                view.own = fit_shape(prep.photo_silhouette, grey, config.shape, camera, float(dec.pose[0, 0]))
+                view.own = fit_shape(view.mask, grey, config.shape, camera, float(dec.pose[0, 0]))
             view.used = True
         except FIT_ERRORS as e:
             view.reason = f"its shape fit failed ({type(e).__name__}: {e})"
@@ -126,46 +170,53 @@ def choose_side_views(views: list[ViewFit], config: MultiviewConfig) -> None:
     candidates = [v for v in views if v.used]
     if len(candidates) < 3:
         return  # two views cannot outvote each other
-    spread = profile_spread([v.own for v in candidates])
-    typical = float(np.median([v.own.outline_error for v in candidates]))
+    spread = profile_spread([v.own_fit for v in candidates])
+    typical = float(np.median([v.own_fit.outline_error for v in candidates]))
     for view, s in zip(candidates, spread):
         if s > config.max_spread:
             view.used, view.reason = False, f"not a side view: its own profile differs from the others' by {s:.0%}"
-        elif view.own.outline_error > max(config.max_outline_ratio * typical, 2.0):
-            view.used, view.reason = False, (f"not a side view: its own outline fits {view.own.outline_error:.1f} px "
-                                             f"off (the views' median {typical:.1f} px)")
+        elif view.own_fit.outline_error > max(config.max_outline_ratio * typical, 2.0):
+            error = view.own_fit.outline_error
+            view.used, view.reason = False, (f"not a side view: its own outline fits {error:.1f} px off (the "
+                                             f"views' median {typical:.1f} px)")
 
 
 def read_appearance(view: ViewFit, predictor: Predictor) -> None:
     """A view's lighting and material at its geometry: the networks re-read there and the light fitted
     (derender.refine.driver.read_at_shape; `--refine shape`: not fitted; `--refine none`: the network's first
     reading, the geometry replaced)."""
-    radius, height, pose = view.geometry
-    report = RefineReport("refined", "", view.prepared.side, view.own.pitch_cue, (view.outline_px, float("nan")))
+    solid, network = view.solid, view.network
+    assert network is not None
+    report = RefineReport("refined", "", view.crops.side, view.own_fit.pitch_cue, (view.outline_px, float("nan")))
     if predictor.refine == "none":
-        view.appearance = dataclasses.replace(view.network, radius=radius, height=height, pose=pose)
+        view.appearance = dataclasses.replace(network, radius=solid.radius, height=solid.height, pose=solid.pose)
         view.report = report
         return
-    image = torch.from_numpy(view.prepared.image).permute(2, 0, 1)[None].float() / 255.0
+    image = torch.from_numpy(view.crops.image).permute(2, 0, 1)[None].float() / 255.0
     light = LightFitConfig() if predictor.refine == "full" else None
     with torch_threads(1):
         appearance, view.report = read_at_shape(
-            predictor.model, image.to(predictor.device), view.network.to(predictor.device), view.geometry,
-            view.prepared.photo_image, view.prepared.photo_silhouette, predictor.setup.camera, light,
+            predictor.model, image.to(predictor.device), network.to(predictor.device), solid,
+            view.photo, view.mask, predictor.setup.camera, light,
             predictor.reader, report)
     view.appearance = appearance.to("cpu")
 
 
 def unwrap_texture(view: ViewFit, predictor: Predictor) -> ViewTexture:
     """A view's photograph unwrapped over 360 deg at its geometry and divided by its shading."""
-    a = view.appearance
-    photo, coverage = photo_tensors(view.prepared)
+    a = view.looks
+    photo, coverage = photo_tensors(view.crops)
     if coverage is None:
         coverage = torch.ones_like(photo[:, :1])
-    radius = smooth_rows(a.radius.float(), max(PROFILE_ROWS, a.radius.shape[1]))
     render = ObjectState.export_render(predictor.setup.render)
-    return unwrap_view(photo, coverage, radius, a.height.float(), a.pose.float(), a.env.float(), a.alpha.float(),
-                       a.rho.float(), view.prepared.side, render, predictor.setup.camera)
+    return unwrap_view(photo, coverage, exported_solid(a), a.material.map(torch.Tensor.float), view.crops.side,
+                       render, predictor.setup.camera)
+
+
+def exported_solid(dec: Decomposition) -> Solid:
+    """A fitted Decomposition's solid as exported: its profile resampled to PROFILE_ROWS rows (at least), float."""
+    radius = smooth_rows(dec.radius.float(), max(PROFILE_ROWS, dec.radius.shape[1]))
+    return Solid(radius, dec.height.float(), dec.pose.float())
 
 
 def fit_object(views: list[ViewFit], decs: list[Decomposition], predictor: Predictor,
@@ -188,29 +239,31 @@ def fit_chosen(views: list[ViewFit], predictor: Predictor, config: MultiviewConf
     used = [v for v in views if v.used]
     if not used:
         raise ValueError("no view could be fitted: " + "; ".join(f"{v.source}: {v.reason}" for v in views))
-    geometries, errors = fit_jointly([v.prepared.photo_silhouette for v in used], [v.own for v in used],
+    geometries, errors = fit_jointly([v.mask for v in used], [v.own_fit for v in used],
                                      config.shape, predictor.setup.camera)
     for view, geometry, error in zip(used, geometries, errors):
         view.geometry, view.outline_px = geometry, error
         read_appearance(view, predictor)
         view.texture = unwrap_texture(view, predictor)
     if turns is None:
-        turns = register_turns([v.texture for v in used], config.turns)
+        found = register_turns([v.tex for v in used], config.turns)
     else:
-        turns = Turns(tuple(turns), (False,) * len(used), (float("nan"),) * len(used))
-    for view, turn, registered, agreement in zip(used, turns.degrees, turns.registered, turns.agreement):
+        found = Turns(tuple(turns), (False,) * len(used), (float("nan"),) * len(used))
+    for view, turn, registered, agreement in zip(used, found.degrees, found.registered, found.agreement):
         view.turn, view.registered, view.agreement = turn, registered, agreement
-    turned = match_exposure([v.texture.turned(v.turn) for v in used], config.fuse)
-    return ObjectFit(views, fuse(turned, config.fuse), turns)
+    turned = match_exposure([v.tex.turned(v.turn) for v in used], config.fuse)
+    return ObjectFit(views, fuse(turned, config.fuse), found)
 
 
 def object_state(fit: ObjectFit, predictor: Predictor) -> ObjectState:
     """The exported object: the first used view's geometry, lighting and material, the fused albedo."""
-    first = fit.used[0].appearance
+    first = fit.used[0].looks
     setup = predictor.setup
-    radius = smooth_rows(first.radius.float(), max(PROFILE_ROWS, first.radius.shape[1]))
-    state = ObjectState.from_decomposition(dataclasses.replace(first, radius=radius), setup.render, setup.camera)
-    return dataclasses.replace(state, albedo=quantise(fit.fused.albedo, setup.render.gamma))
+    solid = exported_solid(first)
+    state = ObjectState.from_decomposition(dataclasses.replace(first, radius=solid.radius), setup.render,
+                                           setup.camera)
+    albedo = quantise(fit.fused_map.albedo, setup.render.gamma)
+    return dataclasses.replace(state, material=state.material.with_albedo(albedo))
 
 
 def views_record(fit: ObjectFit) -> dict:

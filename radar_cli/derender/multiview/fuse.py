@@ -14,8 +14,10 @@ import torch
 
 from radar_cli.config import CameraConfig, RenderConfig
 from radar_cli.render.lighting import decompose
+from radar_cli.render.material import Material
 from radar_cli.render.scene import MAX_SPECULAR_SHARE, rotate_full_map, shade
 from radar_cli.render.texture import sample_surface
+from radar_cli.sor.solid import Solid
 from radar_cli.sor.surface import FULL_SPAN, surface_grid
 
 PALETTE = np.array([[230, 60, 50], [60, 180, 75], [50, 110, 230], [240, 200, 40], [190, 80, 200], [70, 200, 210],
@@ -59,26 +61,31 @@ class ViewTexture:
 
 
 @torch.no_grad()
-def unwrap_view(photo: torch.Tensor, coverage: torch.Tensor, radius: torch.Tensor, height: torch.Tensor,
-                pose: torch.Tensor, env: torch.Tensor, alpha: torch.Tensor, rho: torch.Tensor, rows: int,
+def unwrap_view(photo: torch.Tensor, coverage: torch.Tensor, solid: Solid, material: Material, rows: int,
                 render: RenderConfig, camera: CameraConfig) -> ViewTexture:
     """A view's 360 deg albedo: the photograph sampled at the surface and divided by the view's shading.
 
     Args:
         photo: 1 x 3 x N x N tone-mapped image in [0, 1]; coverage: 1 x 1 x N x N object coverage.
-        radius: 1 x L; height: 1; pose: 1 x 4; env: 1 x He x We; alpha, rho: 1 (the view's fit).
+        solid: the view's fitted solid (batch of one); material: its light and gloss (its albedo unused).
         rows: Ht; the map is Ht x 3 Ht.
         render: its shading grid and gamma; camera: the fixed camera.
     """
     cols = 3 * rows
-    grid = surface_grid(radius, height, pose, rows, cols, camera, FULL_SPAN)
+    grid = surface_grid(solid, rows, cols, camera, FULL_SPAN)
     sampled = sample_surface(torch.cat([photo, coverage], 1), grid, camera)  # 1 x 4 x Ht x 3Wt
     facing = (grid.normals * grid.view).sum(-1).clamp_min(0.0)[:, None]  # 1 x 1 x Ht x 3Wt
     on_object = ((sampled[:, 3:] - 0.5) * 2).clamp(0.0, 1.0)
-    ones = torch.ones(1, 3, rows, cols)
-    shading = shade(radius, height, pose, ones, env, alpha, rho, render, camera, span=FULL_SPAN)
-    albedo = decompose(sampled[:, :3], shading.diffuse, shading.specular, rho, render.gamma, MAX_SPECULAR_SHARE)
+    lit = material.with_albedo(torch.ones(1, 3, rows, cols))
+    shading = shade(solid, lit, render, camera, span=FULL_SPAN)
+    albedo = decompose(sampled[:, :3], shading.diffuse, shading.specular, material.rho, render.gamma,
+                       MAX_SPECULAR_SHARE)
     return ViewTexture(albedo, facing * on_object)
+
+
+def _log_mean(view: ViewTexture, where: torch.Tensor) -> torch.Tensor:
+    """3 per-channel means of the log albedo over the texels `where` (1 x 1 x Ht x W bool) marks."""
+    return view.albedo.clamp_min(1e-3).log().masked_select(where.expand_as(view.albedo)).view(3, -1).mean(1)
 
 
 def match_exposure(views: list[ViewTexture], config: FuseConfig = FuseConfig()) -> list[ViewTexture]:
@@ -92,11 +99,10 @@ def match_exposure(views: list[ViewTexture], config: FuseConfig = FuseConfig()) 
             both = (views[i].weight > lo) & (views[j].weight > lo)  # 1 x 1 x Ht x W
             if int(both.sum()) < 20:
                 continue
-            mean = lambda v: v.albedo.clamp_min(1e-3).log().masked_select(both.expand_as(v.albedo)).view(3, -1).mean(1)  # noqa: E731
             row = np.zeros(count)
             row[i], row[j] = -1.0, 1.0
             rows.append(row)
-            rhs.append((mean(views[i]) - mean(views[j])).numpy())  # log g_j - log g_i
+            rhs.append((_log_mean(views[i], both) - _log_mean(views[j], both)).numpy())  # log g_j - log g_i
             weights.append(np.sqrt(float(both.sum())))
     if not rows:
         return views

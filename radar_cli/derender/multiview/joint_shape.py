@@ -10,10 +10,11 @@ import torch
 from radar_cli.config import CameraConfig
 from radar_cli.derender.refine.fit_shape import ShapeFit, ShapeFitConfig, downsample, outline_score, roughness
 from radar_cli.sor.outline import Outline, mask_outline, outline
+from radar_cli.sor.solid import Solid
 
 OUTLINE_FIELDS = ("left", "right", "top", "bottom")
-Geometry = tuple[torch.Tensor, torch.Tensor, torch.Tensor]
-"""(radius 1 x L, height 1, pose 1 x 4) of one view."""
+Geometry = Solid
+"""One view's solid: radius 1 x L, height 1, pose 1 x 4."""
 
 
 def stacked(outlines: list[Outline]) -> Outline:
@@ -44,7 +45,7 @@ def _polish(target: Outline, size: int, profile: torch.Tensor, height: torch.Ten
             config: ShapeFitConfig, camera: CameraConfig) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """Adam on the shared profile (1 x L, radii over half-height) and each view's half-height (V), roll and offsets
     (V x 4 pose, pitch held) against the V views' outlines; scaled as fit_shape.polish."""
-    rows, views = profile.shape[1], len(height)
+    views = len(height)
     shape = (profile[0] * 100).detach().clone().requires_grad_(True)
     own = torch.cat([height[:, None] * 100, pose[:, 1:2], pose[:, 2:] * 100], 1).detach().clone().requires_grad_(True)
     pitch = pose[:, :1].detach()
@@ -58,7 +59,7 @@ def _polish(target: Outline, size: int, profile: torch.Tensor, height: torch.Ten
     for _ in range(steps):
         opt.zero_grad()
         r, h, p = unpack()
-        fit = outline_score(outline(r, h, p, size, camera), target).sum()
+        fit = outline_score(outline(Solid(r, h, p), size, camera), target).sum()
         loss = fit + config.roughness_weight * views * roughness(r.mean(0, keepdim=True)).sum()
         loss.backward()
         opt.step()
@@ -76,8 +77,8 @@ def fit_jointly(masks: list[np.ndarray], fits: list[ShapeFit], config: ShapeFitC
         fits: each view's own fit (fit_shape) at N: its pitch is kept, the rest is the start.
 
     Returns:
-        (per view (radius 1 x L, height 1, pose 1 x 4), float32, the radii the shared profile times the view's
-        half-height; per view the mean outline distance in px at N).
+        (per view its Solid (radius 1 x L, height 1, pose 1 x 4), float32, the radii the shared profile times the
+        view's half-height; per view the mean outline distance in px at N).
     """
     size = masks[0].shape[0]
     grid = min(size, config.grid_size)
@@ -91,7 +92,7 @@ def fit_jointly(masks: list[np.ndarray], fits: list[ShapeFit], config: ShapeFitC
     radius = profile * height[:, None]
     with torch.no_grad():
         full = stacked([mask_outline(np.asarray(m, np.float64)) for m in masks])
-        drawn = outline(radius, height, pose, size, camera)
+        drawn = outline(Solid(radius, height, pose), size, camera)
         errors = [float(outline_score(_view(drawn, k), _view(full, k), absolute=True)[0]) for k in range(len(masks))]
-    geos = [(radius[k:k + 1].float(), height[k:k + 1].float(), pose[k:k + 1].float()) for k in range(len(masks))]
+    geos = [Solid(radius[k:k + 1].float(), height[k:k + 1].float(), pose[k:k + 1].float()) for k in range(len(masks))]
     return geos, errors

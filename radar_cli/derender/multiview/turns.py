@@ -17,7 +17,6 @@ import torch.nn.functional as F
 
 from radar_cli.derender.multiview.fuse import ViewTexture
 
-
 SPREAD_TIE_BREAK = 1e-6  # per degree of the smallest gap between views: decides only between equal scores
 
 
