@@ -122,6 +122,55 @@ def sor_score(mask: np.ndarray) -> float:
     return best
 
 
+def _ends(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per row of a bool mask its first and last column (NaN on empty rows)."""
+    filled = mask.any(1)
+    first = np.where(filled, mask.argmax(1), np.nan)
+    last = np.where(filled, mask.shape[1] - 1 - mask[:, ::-1].argmax(1), np.nan)
+    return first, last
+
+
+def outline_residual(silhouette: np.ndarray, solid: np.ndarray) -> float | None:
+    """How far a fitted solid's outline departs from a silhouette's, as a share of the silhouette's height:
+    the mean distance of their row ends (left and right, per row) and column ends (top and bottom, per
+    column), over the lines both cross. A solid of revolution follows a vessel's outline to a pixel or two; a
+    broken edge, a sherd's outline or a lid that is not turned leaves it off by several percent of the height.
+
+    Args:
+        silhouette, solid: H x W bool masks in the same view. Returns None if they share no line.
+    """
+    rows = np.nonzero(silhouette.any(1))[0]
+    if rows.size == 0:
+        return None
+    gaps = []
+    for a, b in ((silhouette, solid), (silhouette.T, solid.T)):
+        (a0, a1), (b0, b1) = _ends(a), _ends(b)
+        both = ~np.isnan(a0) & ~np.isnan(b0)
+        gaps += [np.abs(a0 - b0)[both], np.abs(a1 - b1)[both]]
+    gap = np.concatenate(gaps)
+    return float(gap.mean() / (rows[-1] - rows[0] + 1)) if gap.size else None
+
+
+def roundness(mask: np.ndarray) -> float:
+    """How nearly a bool mask is a filled ellipse (1 = exactly): the IoU of the mask with the ellipse of the
+    same second moments. A vessel seen from the side has a rim and a foot that cut its outline straight; a
+    view from above into the mouth (or a round dish face on) is an ellipse."""
+    m = mask.astype(np.uint8)
+    moments = cv2.moments(m, binaryImage=True)
+    if moments["m00"] < 10:
+        return 0.0
+    cx, cy = moments["m10"] / moments["m00"], moments["m01"] / moments["m00"]
+    cov = np.array([[moments["mu20"], moments["mu11"]], [moments["mu11"], moments["mu02"]]]) / moments["m00"]
+    values, vectors = np.linalg.eigh(cov)
+    axes = 2.0 * np.sqrt(np.maximum(values, 1e-9))  # a filled ellipse's semi-axes from its variances
+    angle = float(np.degrees(np.arctan2(vectors[1, 1], vectors[0, 1])))
+    ellipse = np.zeros_like(m)
+    cv2.ellipse(ellipse, (int(round(cx)), int(round(cy))), (int(round(axes[1])), int(round(axes[0]))), angle, 0,
+                360, 1, -1)
+    inter = np.logical_and(m, ellipse).sum()
+    return float(inter / max(np.logical_or(m, ellipse).sum(), 1))
+
+
 def score_mask(mask: np.ndarray, region: tuple[int, int, int, int] | None = None) -> dict[str, float | bool]:
     """All quality scores of a crop's bool mask; `region` is the part of the crop inside the photo."""
     region = region or (0, 0, mask.shape[1], mask.shape[0])

@@ -82,3 +82,83 @@ def test_derender_records_quality_and_appendages(tmp_path: Path) -> None:
     assert appendages.any() and appendages.shape == (record["resolution"],) * 2  # at the output side
     row = next(csv.DictReader((out / "summary.csv").open()))
     assert row["object"] == "amphora" and row["status"] == quality["status"] and row["cut_edges"] == "top bottom"
+
+
+def _vase_on_white(seed: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """A rendered, shaded vase on white (256 px) and its silhouette."""
+    from radar_cli.masks.synthetic import render_vases
+
+    image, alpha, mask = render_vases(1, 256, seed=seed)
+    photo = image[0] + (1 - alpha[0][..., None])
+    return (photo * 255 + 0.5).clip(0, 255).astype(np.uint8), mask[0]
+
+
+def _painted(h: int, w: int, rng: np.random.Generator) -> np.ndarray:
+    """h x w x 3 uint8 paint in horizontal bands and blocks, evenly lit (no shading)."""
+    yy, xx = np.mgrid[0:h, 0:w]
+    pick = ((yy // 12) % 3 == 0) | (((xx // 16 + yy // 16) % 4 == 0) & ((yy // 40) % 2 == 0))
+    colours = rng.uniform(40, 220, (2, 3))
+    return np.where(pick[..., None], colours[0], colours[1]).astype(np.uint8)
+
+
+def _judged(photo: np.ndarray, sil: np.ndarray, rendered: np.ndarray, recon: np.ndarray) -> tuple[str, list[str]]:
+    from radar_cli.derender.export.quality import fit_scores
+
+    return judge({**GOOD, **fit_scores(photo, sil, None, rendered, recon)})
+
+
+def test_a_clean_vase_stays_ok() -> None:
+    photo, sil = _vase_on_white()
+    assert _judged(photo, sil, sil, photo) == ("ok", [])
+
+
+def test_a_flat_slab_is_not_ok_though_a_cylinder_draws_it() -> None:
+    """A painted rectangle: a cylinder fits its outline exactly and the fitted light can draw it, but the photo
+    shows no shading across it."""
+    photo = np.full((256, 256, 3), 255, np.uint8)
+    sil = np.zeros((256, 256), bool)
+    sil[40:220, 70:190] = True
+    photo[sil] = _painted(180, 120, np.random.default_rng(0)).reshape(-1, 3)
+    status, reasons = _judged(photo, sil, sil, photo)
+    assert status == "review" and any("flat piece" in r for r in reasons), reasons
+
+
+def test_a_sherd_cut_out_is_not_ok() -> None:
+    """An irregular broken piece; the solid (each row's run made symmetric about the middle) is drawn where the
+    network would put it."""
+    import cv2
+
+    photo = np.full((256, 256, 3), 255, np.uint8)
+    mask = np.zeros((256, 256), np.uint8)
+    cv2.fillPoly(mask, [np.array([[60, 80], [150, 40], [200, 90], [190, 200], [120, 215], [70, 170]], np.int32)], 1)
+    sil = mask > 0
+    photo[sil] = _painted(256, 256, np.random.default_rng(1))[sil]
+    cols = np.arange(256)
+    solid = np.zeros_like(sil)
+    for y in np.nonzero(sil.any(1))[0]:
+        xs = cols[sil[y]]
+        solid[y] = np.abs(cols - 128) <= (xs.max() - xs.min()) / 2
+    status, reasons = _judged(photo, sil, solid, photo)
+    assert status == "review" and any("symmetric" in r or "sherd" in r for r in reasons), reasons
+
+
+def test_invented_highlights_are_flagged() -> None:
+    photo, sil = _vase_on_white()
+    recon = photo.copy()
+    ys, xs = np.nonzero(sil)
+    blob = (np.abs(ys - ys.mean()) < 0.3 * np.ptp(ys)) & (np.abs(xs - xs.mean()) < 0.2 * np.ptp(xs))
+    recon[ys[blob], xs[blob]] = 255  # a white highlight over a fifth of the object the photo does not have
+    status, reasons = _judged(photo, sil, sil, recon)
+    assert status == "review" and any("highlights" in r for r in reasons), reasons
+
+
+def test_a_view_into_the_mouth_is_not_ok() -> None:
+    """From above a vessel is a disc: the status asks for a side view."""
+    import cv2
+
+    photo, _ = _vase_on_white()
+    disc = np.zeros((256, 256), np.uint8)
+    cv2.circle(disc, (128, 128), 90, 1, -1)
+    sil = disc > 0
+    status, reasons = _judged(photo, sil, sil, photo)
+    assert status == "review" and any("side view" in r for r in reasons), reasons

@@ -8,12 +8,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from radar_cli.derender.export.likeness import colour_shift, highlight_excess, mouth_error, shading_range
 from radar_cli.derender.export.renders import ViewRenderer
 from radar_cli.derender.run.inputs import Prepared
 from radar_cli.derender.run.state import ObjectState
 from radar_cli.masks.crop import outside_mask
 from radar_cli.masks.outline import outline_support
-from radar_cli.masks.quality import sor_score
+from radar_cli.masks.quality import outline_residual, roundness, sor_score
 from radar_cli.masks.refine import iou
 
 STATUSES = ("failed", "review", "ok")  # worst first: the order a curator reads them in
@@ -42,6 +43,24 @@ class QualityLimits:
     review_support: float = 0.65
     """Share of the silhouette's outline on an edge of the photo (`outline_support`) below this: review (the
     silhouette does not sit on the object's edge)."""
+    review_object_symmetry: float = 0.8
+    """Solid-of-revolution score of the whole located object (core and appendages) below this: review (a
+    fragment, a figure or lid that is not turned, a neighbour in the silhouette)."""
+    review_residual: float = 0.03
+    """The solid's outline off the silhouette's by more than this share of its height: review (a broken edge,
+    a sherd's outline)."""
+    review_roundness: float = 0.9
+    """The object's silhouette this close to a filled ellipse or closer: review (a view into the mouth from
+    above, not a side view)."""
+    review_shading: float = 0.12
+    """Brightness across the object changing by less than this (`shading_range`): review (a flat piece)."""
+    review_mouth: float = 0.2
+    """The drawn inside of the mouth off the photo by more than this (mean luminance, 0..1): review (a mouth
+    drawn where the photo shows the outer wall: the pitch too high, or no vessel)."""
+    review_highlights: float = 0.08
+    """More than this share of the object drawn much brighter than the photo: review (invented highlights)."""
+    review_colour: float = 15.0
+    """The reconstruction's mean chroma further than this from the photo's (CIELAB): review."""
 
 
 def psnr(a: np.ndarray, b: np.ndarray) -> float:
@@ -69,27 +88,46 @@ def support(prepared: Prepared) -> float | None:
     return outline_support(prepared.photo_scene, sil, measurable)
 
 
-def scores(prepared: Prepared, rendered: np.ndarray, recon: np.ndarray) -> dict:
+def scores(prepared: Prepared, rendered: np.ndarray, recon: np.ndarray, mouth: np.ndarray | None = None) -> dict:
     """The numbers of the quality record.
 
     Args:
         prepared: the input, with its located silhouette (core) and appendages at the output side N.
         rendered: N x N bool silhouette of the de-rendered solid in the input view.
         recon: N x N x 3 uint8 reconstruction of the input (over white).
+        mouth: N x N bool, where the solid's inside is seen through its mouth (None: nowhere).
     """
-    sil = prepared.photo_silhouette
     assert prepared.photo_image is not None  # Prepared sets it
+    return {**fit_scores(prepared.photo_image, prepared.photo_silhouette, prepared.appendages, rendered, recon, mouth),
+            "outline_support": _round(support(prepared)),
+            "cut_edges": list(prepared.cut_edges),
+            "frame_coverage": _round(prepared.frame_coverage)}
+
+
+def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None, rendered: np.ndarray,
+               recon: np.ndarray, mouth: np.ndarray | None = None) -> dict:
+    """The scores that compare the silhouette, the solid and the reconstruction (all N x N, as written in an
+    object's folder: input.png, silhouette.png, appendages.png, the solid's mask, recon.png).
+
+    Args:
+        photo: N x N x 3 uint8 input. sil: N x N bool core or None. app: N x N bool appendages or None.
+        rendered: N x N bool solid. recon: N x N x 3 uint8. mouth: N x N bool drawn inside of the mouth, or None.
+    """
     region = sil if sil is not None else rendered
-    app = prepared.appendages
-    whole = None if sil is None else int(sil.sum()) + (0 if app is None else int(app.sum()))
+    whole = None if sil is None else (sil if app is None else sil | app)
+    mouth = np.zeros_like(rendered) if mouth is None else mouth
     return {
         "silhouette_iou": None if sil is None else _round(iou(rendered, sil)),
         "symmetry": None if sil is None else _round(sor_score(sil)),
-        "recon_psnr": _round(psnr(recon[region], prepared.photo_image[region]), 2) if region.any() else None,
-        "appendage_fraction": None if app is None or not whole else _round(float(app.sum()) / whole),
-        "outline_support": _round(support(prepared)),
-        "cut_edges": list(prepared.cut_edges),
-        "frame_coverage": _round(prepared.frame_coverage),
+        "object_symmetry": None if whole is None else _round(sor_score(whole)),
+        "outline_residual": None if sil is None else _round(outline_residual(sil, rendered)),
+        "roundness": None if whole is None else _round(roundness(whole)),
+        "recon_psnr": _round(psnr(recon[region], photo[region]), 2) if region.any() else None,
+        "mouth_error": _round(mouth_error(photo, recon, region & rendered, mouth)),
+        "highlight_excess": _round(highlight_excess(photo, recon, region & rendered)),
+        "colour_shift": _round(colour_shift(photo, recon, region & rendered), 2),
+        "shading_range": _round(shading_range(photo, region, rendered)),
+        "appendage_fraction": None if app is None or not whole.any() else _round(float(app.sum()) / whole.sum()),
         "silhouette_area": None if sil is None else _round(float(sil.mean())),
     }
 
@@ -120,11 +158,35 @@ def judge(record: dict, limits: QualityLimits = QualityLimits()) -> tuple[str, l
         review.append(f"reconstruction far from the photo ({rec_psnr:.1f} dB)")
     if outline is not None and outline < limits.review_support:
         review.append(f"silhouette off the object's edge ({outline:.0%} of its outline on an edge)")
+    review += likeness_reasons(record, limits)
     if len(record.get("cut_edges", [])) >= limits.review_cut_edges:
         review.append(f"cut by {len(record['cut_edges'])} photo edges")
     if failed:
         return "failed", failed + review
     return ("review", review) if review else ("ok", [])
+
+
+def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> list[str]:
+    """The reasons, in a curator's words, that the photo shows something other than one whole vessel seen
+    from the side, or that the reconstruction does not look like the photo."""
+    checks = (
+        ("object_symmetry", lambda v: v < limits.review_object_symmetry,
+         "the object as photographed is not symmetric about an axis ({:.2f}): a fragment, a lid or figure that "
+         "is not turned, or a neighbour in the silhouette?"),
+        ("outline_residual", lambda v: v > limits.review_residual,
+         "the solid's outline is off the silhouette by {:.1%} of the height: a broken edge or a sherd?"),
+        ("roundness", lambda v: v >= limits.review_roundness,
+         "the silhouette is round ({:.2f}): a view from above into the mouth, not a side view?"),
+        ("shading_range", lambda v: v < limits.review_shading,
+         "no shading across the object ({:.2f}): a flat piece, not a vessel?"),
+        ("mouth_error", lambda v: v > limits.review_mouth,
+         "the reconstruction draws the inside of the mouth where the photo shows something else ({:.2f})"),
+        ("highlight_excess", lambda v: v > limits.review_highlights,
+         "the reconstruction has highlights the photo does not have ({:.0%} of the object)"),
+        ("colour_shift", lambda v: v > limits.review_colour,
+         "the reconstruction's colour is off the photo's ({:.0f})"),
+    )
+    return [words.format(record[key]) for key, bad, words in checks if record.get(key) is not None and bad(record[key])]
 
 
 def assess(prepared: Prepared, state: ObjectState, limits: QualityLimits = QualityLimits()) -> dict:
@@ -137,18 +199,20 @@ def assess(prepared: Prepared, state: ObjectState, limits: QualityLimits = Quali
         limits: the thresholds.
     """
     view = ViewRenderer(state, prepared.side)
-    return assess_drawn(prepared, view.hits.mask[0].numpy(), view.draw(view.shading()), limits)
+    return assess_drawn(prepared, view.hits.mask[0].numpy(), view.draw(view.shading()), view.hits.inner[0].numpy(),
+                        limits)
 
 
-def assess_drawn(prepared: Prepared, rendered: np.ndarray, recon: np.ndarray,
+def assess_drawn(prepared: Prepared, rendered: np.ndarray, recon: np.ndarray, mouth: np.ndarray | None = None,
                  limits: QualityLimits = QualityLimits()) -> dict:
     """The `quality` record from the object drawn in the input view: its scores, status and reasons.
 
     Args:
         prepared: the input crop and its located silhouette.
         rendered: N x N bool silhouette of the final de-rendered solid; recon: N x N x 3 uint8 over white.
+        mouth: N x N bool, where the solid's inside is seen through the mouth (None: nowhere).
         limits: the thresholds.
     """
-    record = scores(prepared, rendered, recon)
+    record = scores(prepared, rendered, recon, mouth)
     status, reasons = judge(record, limits)
     return {"status": status, "reasons": reasons, **record}

@@ -207,12 +207,12 @@ def write_relit(folder: Path, view: ViewRenderer, envs: dict[str, np.ndarray]) -
 
 
 def write_renders(folder: Path, state: ObjectState, input_size: int, view_size: int, frames: int,
-                  envs: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+                  envs: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every render of one object; the turntable and relit views reuse the input view's rays at its size.
 
     Returns:
-        The input view's hard silhouette (S x S bool) and reconstruction (S x S x 3 uint8), for the quality
-        checks."""
+        The input view's hard silhouette (S x S bool), where it shows the inside through the mouth (S x S bool)
+        and its reconstruction (S x S x 3 uint8), for the quality checks."""
     input_view, recon = write_input_view(folder, state, input_size)
     write_picture(folder / MATERIAL_SPHERE_FILE, material_sphere(state, view_size))
     hits = input_view.hits if view_size == input_size else None
@@ -220,4 +220,4 @@ def write_renders(folder: Path, state: ObjectState, input_size: int, view_size: 
     if frames > 0:
         write_turntable(folder, view, frames)
     write_relit(folder, view, envs)
-    return input_view.hits.mask[0].numpy(), recon
+    return input_view.hits.mask[0].numpy(), input_view.hits.inner[0].numpy(), recon

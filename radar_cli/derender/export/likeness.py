@@ -1,0 +1,94 @@
+"""Does the reconstruction look like the photograph? Scores of recon.png against the photo inside the located
+silhouette, each aimed at one way a de-rendering goes wrong on real photographs: a mouth drawn where the photo
+shows the outer wall (a pitch too high, a flat object rebuilt as an open vessel), highlights the photo does not
+have, a colour shift."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+BRIGHTER = 0.15
+"""A recon pixel this much brighter than the photo's (luminance, 0..1) is a highlight the photo does not have."""
+MIN_MOUTH_SHARE = 0.08
+"""A drawn mouth covering less of the silhouette than this is not scored (a narrow neck's mouth, a sliver at a
+level pitch)."""
+LUMA = np.array([0.299, 0.587, 0.114])
+
+
+def luminance(image: np.ndarray) -> np.ndarray:
+    """H x W luminance in 0..1 of an H x W x 3 uint8 image."""
+    return (image.astype(np.float64) / 255.0) @ LUMA
+
+
+def mouth_error(photo: np.ndarray, recon: np.ndarray, region: np.ndarray, mouth: np.ndarray) -> float | None:
+    """Mean absolute luminance difference (0..1) between the reconstruction and the photo where the
+    reconstruction shows the inside of the vessel through its mouth; None where the drawn mouth covers less
+    than MIN_MOUTH_SHARE of the region.
+
+    Args:
+        photo, recon: H x W x 3 uint8. region: H x W bool (the silhouette). mouth: H x W bool, the pixels where
+            the solid's inside is seen (raycast `Hits.inner`).
+    """
+    inside = region & mouth
+    if not region.any() or inside.sum() < MIN_MOUTH_SHARE * region.sum():
+        return None
+    return float(np.abs(luminance(recon)[inside] - luminance(photo)[inside]).mean())
+
+
+def highlight_excess(photo: np.ndarray, recon: np.ndarray, region: np.ndarray) -> float | None:
+    """Share of the region where the reconstruction is BRIGHTER than the photo: highlights the fitted lighting
+    draws and the photo does not show (None for an empty region)."""
+    if not region.any():
+        return None
+    return float(((luminance(recon) - luminance(photo))[region] > BRIGHTER).mean())
+
+
+def colour_shift(photo: np.ndarray, recon: np.ndarray, region: np.ndarray) -> float | None:
+    """Distance of the chroma (CIELAB a*, b*) of the reconstruction's mean colour inside the region from the
+    photo's: about 2 is invisible, above 10 the reconstruction is another colour (None for an empty region)."""
+    if not region.any():
+        return None
+    means = np.stack([im[region].astype(np.float32).mean(0) / 255.0 for im in (photo, recon)])[None]  # 1 x 2 x 3
+    lab = cv2.cvtColor(means, cv2.COLOR_RGB2LAB)[0]
+    return float(np.linalg.norm(lab[0, 1:] - lab[1, 1:]))
+
+
+def _row_ends(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per row of a bool mask its first and last column (-1 on empty rows)."""
+    filled = mask.any(1)
+    return (np.where(filled, mask.argmax(1), -1),
+            np.where(filled, mask.shape[1] - 1 - mask[:, ::-1].argmax(1), -1))
+
+
+def shading_range(photo: np.ndarray, region: np.ndarray, solid: np.ndarray, bins: int = 10) -> float | None:
+    """How much the photo's brightness changes across the object: each row (the middle 80 % of the rows) is
+    cut into `bins` strips across the fitted solid's width and each strip's mean luminance taken relative to
+    the row's median; the range (max - min) of the strips' medians over the rows. Paint changes from row to
+    row and averages out; a curved wall is darker or brighter towards its edges (1 or more on vessels), a flat
+    piece is not (under 0.05 on a painted slab). None with too few rows.
+
+    Args:
+        photo: H x W x 3 uint8. region: H x W bool silhouette. solid: H x W bool fitted solid (its row ends
+            give each row's width and axis).
+    """
+    lum = luminance(photo)
+    left, right = _row_ends(solid)
+    rows = np.nonzero(region.any(1) & (right - left >= 10))[0]
+    rows = rows[int(0.1 * rows.size):int(0.9 * rows.size)]
+    if rows.size < 5:
+        return None
+    xs = np.arange(photo.shape[1])
+    strips = np.full((rows.size, bins), np.nan)
+    for i, y in enumerate(rows):
+        u = (2 * xs - left[y] - right[y]) / (right[y] - left[y])  # -1..1 across the solid
+        inside = region[y] & (np.abs(u) <= 1)
+        if not inside.any():
+            continue
+        values, which = lum[y][inside], np.minimum(((u[inside] + 1) / 2 * bins).astype(int), bins - 1)
+        sums, counts = np.bincount(which, values, bins), np.bincount(which, minlength=bins)
+        strips[i] = np.where(counts > 0, sums / np.maximum(counts, 1), np.nan) / (np.median(values) + 1e-3)
+    if np.isnan(strips).all(0).any():
+        return None
+    profile = np.nanmedian(strips, 0)
+    return float(profile.max() - profile.min())
