@@ -78,16 +78,16 @@ def shading_range(photo: np.ndarray, region: np.ndarray, solid: np.ndarray, bins
     rows = rows[int(0.1 * rows.size):int(0.9 * rows.size)]
     if rows.size < 5:
         return None
-    xs = np.arange(photo.shape[1])
-    strips = np.full((rows.size, bins), np.nan)
-    for i, y in enumerate(rows):
-        u = (2 * xs - left[y] - right[y]) / (right[y] - left[y])  # -1..1 across the solid
-        inside = region[y] & (np.abs(u) <= 1)
-        if not inside.any():
-            continue
-        values, which = lum[y][inside], np.minimum(((u[inside] + 1) / 2 * bins).astype(int), bins - 1)
-        sums, counts = np.bincount(which, values, bins), np.bincount(which, minlength=bins)
-        strips[i] = np.where(counts > 0, sums / np.maximum(counts, 1), np.nan) / (np.median(values) + 1e-3)
+    l, r = left[rows, None], right[rows, None]
+    u = (2 * np.arange(photo.shape[1])[None] - l - r) / (r - l)  # R x W: -1..1 across the solid
+    inside = region[rows] & (np.abs(u) <= 1)
+    values = np.where(inside, lum[rows], np.nan)
+    median = np.nanmedian(np.where(inside.any(1, keepdims=True), values, 0.0), axis=1)  # R
+    which = np.minimum(((u + 1) / 2 * bins).astype(int), bins - 1).clip(0)
+    index = (np.arange(rows.size)[:, None] * bins + which)[inside]
+    sums = np.bincount(index, lum[rows][inside], rows.size * bins).reshape(-1, bins)
+    counts = np.bincount(index, minlength=rows.size * bins).reshape(-1, bins)
+    strips = np.where(counts > 0, sums / np.maximum(counts, 1), np.nan) / (median[:, None] + 1e-3)
     if np.isnan(strips).all(0).any():
         return None
     profile = np.nanmedian(strips, 0)
