@@ -54,7 +54,7 @@ class QualityLimits:
     above, not a side view)."""
     review_shading: float = 0.12
     """Brightness across the object changing by less than this (`shading_range`): review (a flat piece)."""
-    review_mouth: float = 0.2
+    review_mouth: float = 0.14
     """The drawn inside of the mouth off the photo by more than this (mean luminance, 0..1): review (a mouth
     drawn where the photo shows the outer wall: the pitch too high, or no vessel)."""
     review_highlights: float = 0.08
