@@ -26,7 +26,14 @@ from radar_cli.derender.export.quality import fit_scores, judge, psnr
 from radar_cli.derender.export.renders import ViewRenderer
 from radar_cli.derender.run.state import read_state
 from radar_cli.fileio import read_image
-from radar_cli.results import ALBEDO_RENDERED_FILE, APPENDAGES_FILE, INPUT_FILE, MATERIAL_FILE, RECON_FILE, SILHOUETTE_FILE
+from radar_cli.results import (
+    ALBEDO_RENDERED_FILE,
+    APPENDAGES_FILE,
+    INPUT_FILE,
+    MATERIAL_FILE,
+    RECON_FILE,
+    SILHOUETTE_FILE,
+)
 
 MAX_PITCH, MAX_RATIO_ERROR, MIN_IOU = 8.0, 0.10, 0.85
 EXPECTED_MET = {"DP107005": "not", "DP250469": "not"}  # the head-shaped flasks: not solids of revolution
@@ -137,7 +144,8 @@ def main() -> None:
     args = parser.parse_args()
     cases = {}
     if args.truth_tsv:
-        cases = {r[0]: r[2] for r in (l.split("\t") for l in args.truth_tsv.read_text().splitlines()[1:])}
+        lines = args.truth_tsv.read_text().splitlines()[1:]
+        cases = {row[0]: row[2] for row in (line.split("\t") for line in lines)}
     table = catalogue(args.catalogue)
     counts = defaultdict(lambda: [0, 0, 0, 0])  # n, expected not ok, wrong ones `ok`, right ones not `ok`
     looks = defaultdict(list)
@@ -156,7 +164,8 @@ def main() -> None:
             if args.appearance:
                 looks[group].append(appearance(folder))
             if args.verbose:
-                print(f"{folder.name:28s} {expected:4s} {quality['status']:7s} {why:22s} {'; '.join(quality['reasons'])}")
+                reasons = "; ".join(quality["reasons"])
+                print(f"{folder.name:28s} {expected:4s} {quality['status']:7s} {why:22s} {reasons}")
     if args.sheet:
         sheet(shown, args.sheet)
     print("| set | n | should not be `ok` | wrong ones `ok` | right ones not `ok` |\n|---|---|---|---|---|")

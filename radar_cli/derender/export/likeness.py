@@ -78,8 +78,8 @@ def shading_range(photo: np.ndarray, region: np.ndarray, solid: np.ndarray, bins
     rows = rows[int(0.1 * rows.size):int(0.9 * rows.size)]
     if rows.size < 5:
         return None
-    l, r = left[rows, None], right[rows, None]
-    u = (2 * np.arange(photo.shape[1])[None] - l - r) / (r - l)  # R x W: -1..1 across the solid
+    lo, hi = left[rows, None], right[rows, None]
+    u = (2 * np.arange(photo.shape[1])[None] - lo - hi) / (hi - lo)  # R x W: -1..1 across the solid
     inside = region[rows] & (np.abs(u) <= 1)
     values = np.where(inside, lum[rows], np.nan)
     median = np.nanmedian(np.where(inside.any(1, keepdims=True), values, 0.0), axis=1)  # R

@@ -127,7 +127,8 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
         "highlight_excess": _round(highlight_excess(photo, recon, region & rendered)),
         "colour_shift": _round(colour_shift(photo, recon, region & rendered), 2),
         "shading_range": _round(shading_range(photo, region, rendered)),
-        "appendage_fraction": None if app is None or not whole.any() else _round(float(app.sum()) / whole.sum()),
+        "appendage_fraction": (None if app is None or whole is None or not whole.any()
+                               else _round(float(app.sum()) / whole.sum())),
         "silhouette_area": None if sil is None else _round(float(sil.mean())),
     }
 
