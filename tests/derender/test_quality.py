@@ -153,12 +153,19 @@ def test_invented_highlights_are_flagged() -> None:
 
 
 def test_a_view_into_the_mouth_is_not_ok() -> None:
-    """From above a vessel is a disc: the status asks for a side view."""
+    """From above a vessel is a disc, a lit rim round its dark inside: the status asks for a side view. A round
+    body seen from the side (a disc shaded like a ball) stays `ok`."""
     import cv2
 
-    photo, _ = _vase_on_white()
+    photo = np.full((256, 256, 3), 255, np.uint8)
     disc = np.zeros((256, 256), np.uint8)
     cv2.circle(disc, (128, 128), 90, 1, -1)
     sil = disc > 0
+    yy, xx = np.mgrid[0:256, 0:256]
+    radius = np.hypot(yy - 128, xx - 128) / 90
+    photo[sil] = np.where(radius[sil] > 0.8, 210, 40)[:, None]  # the rim and the inside
     status, reasons = _judged(photo, sil, sil, photo)
     assert status == "review" and any("side view" in r for r in reasons), reasons
+    ball = (255 * np.sqrt(np.clip(1 - radius**2, 0, 1)) * 0.8 + 30).astype(np.uint8)
+    photo[sil] = ball[sil][:, None]
+    assert _judged(photo, sil, sil, photo) == ("ok", [])

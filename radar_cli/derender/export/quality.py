@@ -8,7 +8,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from radar_cli.derender.export.likeness import colour_shift, highlight_excess, mouth_error, shading_range
+from radar_cli.derender.export.likeness import (
+    colour_shift,
+    highlight_excess,
+    mouth_error,
+    rim_contrast,
+    shading_profile,
+    shading_range,
+)
 from radar_cli.derender.export.renders import ViewRenderer
 from radar_cli.derender.run.inputs import Prepared
 from radar_cli.derender.run.state import ObjectState
@@ -50,8 +57,10 @@ class QualityLimits:
     """The solid's outline off the silhouette's by more than this share of its height: review (a broken edge,
     a sherd's outline)."""
     review_roundness: float = 0.9
-    """The object's silhouette this close to a filled ellipse or closer: review (a view into the mouth from
-    above, not a side view)."""
+    """The object's silhouette this close to a filled ellipse or closer, with a lit rim round a dark inside
+    (`review_rim`): review (a view into the mouth from above, not a side view)."""
+    review_rim: float = 2.0
+    """`rim_contrast` at which a round silhouette is read as a view into the mouth."""
     review_shading: float = 0.12
     """Brightness across the object changing by less than this (`shading_range`): review (a flat piece)."""
     review_mouth: float = 0.14
@@ -116,6 +125,7 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
     region = sil if sil is not None else rendered
     whole = None if sil is None else (sil if app is None else sil | app)
     mouth = np.zeros_like(rendered) if mouth is None else mouth
+    profile = shading_profile(photo, region, rendered)
     return {
         "silhouette_iou": None if sil is None else _round(iou(rendered, sil)),
         "symmetry": None if sil is None else _round(sor_score(sil)),
@@ -126,7 +136,8 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
         "mouth_error": _round(mouth_error(photo, recon, region & rendered, mouth)),
         "highlight_excess": _round(highlight_excess(photo, recon, region & rendered)),
         "colour_shift": _round(colour_shift(photo, recon, region & rendered), 2),
-        "shading_range": _round(shading_range(photo, region, rendered)),
+        "shading_range": _round(shading_range(profile)),
+        "rim_contrast": _round(rim_contrast(profile)),
         "appendage_fraction": (None if app is None or whole is None or not whole.any()
                                else _round(float(app.sum()) / whole.sum())),
         "silhouette_area": None if sil is None else _round(float(sil.mean())),
@@ -176,8 +187,9 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
          "is not turned, or a neighbour in the silhouette?"),
         ("outline_residual", lambda v: v > limits.review_residual,
          "the solid's outline is off the silhouette by {:.1%} of the height: a broken edge or a sherd?"),
-        ("roundness", lambda v: v >= limits.review_roundness,
-         "the silhouette is round ({:.2f}): a view from above into the mouth, not a side view?"),
+        ("roundness", lambda v: v >= limits.review_roundness and (record.get("rim_contrast") or 0) >= limits.review_rim,
+         "the silhouette is round ({:.2f}), a lit rim round a dark inside: a view from above into the mouth, "
+         "not a side view?"),
         ("shading_range", lambda v: v < limits.review_shading,
          "no shading across the object ({:.2f}): a flat piece, not a vessel?"),
         ("mouth_error", lambda v: v > limits.review_mouth,
