@@ -1,8 +1,9 @@
 """`radar eval-catalog`: de-rendering results of real photographs measured against a museum catalogue's table of
 dimensions (and, where given, its digitised profile drawings and reference silhouettes).
 
-Result folders are matched to catalogue rows by object id: a folder named `<id>` or `<id>_<view>` (also `-` or
-`.` after the id) belongs to row `<id>`; the longest matching id wins. Per result: the fitted ratios body/height,
+Result folders are matched to the table's rows by object id as `radar derender --dimensions` matches them
+(radar_cli.sizes: a folder named `<id>` or `<id>_<view>`, case-insensitive, the longest matching id); rows
+without a height (fragments) are left out. Per result: the fitted ratios body/height,
 rim/body and foot/body beside the catalogue's and their % errors, the pitch, the quality status; the IoU of the
 drawn silhouette (mask.png) with a reference silhouette (`--silhouettes DIR`: `<result>.png` or
 `<id>_<view>.png` in the photo's pixels); the radius error against a digitised drawing (`--drawings DIR`:
@@ -11,8 +12,6 @@ drawn silhouette (mask.png) with a reference silhouette (`--silhouettes DIR`: `<
 
 from __future__ import annotations
 
-import csv
-import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -24,26 +23,15 @@ from radar_cli.fileio import read_image, read_json
 from radar_cli.masks.crop import CropBox, cut
 from radar_cli.masks.refine import iou
 from radar_cli.results import MASK_FILE, list_results
+from radar_cli.sizes import ObjectSize, read_size_table
 
-DIMENSIONS = ("height_cm", "rim_cm", "body_cm", "foot_cm")
-MAX_TABLE_BYTES = 10 * 1024 * 1024
-SEPARATORS = "_-."
 RATIO_NAMES = ("body/height", "rim/body", "foot/body")
 
 
-@dataclass(frozen=True)
-class CatalogueRow:
-    """One object's catalogue dimensions in cm (None where the table leaves them blank)."""
-
-    object_id: str
-    height: float | None
-    rim: float | None
-    body: float | None
-    foot: float | None
-
-    def ratios(self) -> tuple[float | None, float | None, float | None]:
-        div = lambda a, b: a / b if a is not None and b else None  # noqa: E731
-        return div(self.body, self.height), div(self.rim, self.body), div(self.foot, self.body)
+def catalogue_ratios(size: ObjectSize) -> list[float | None]:
+    """The catalogue's body/height, rim/body and foot/body (None where a diameter is not given)."""
+    div = lambda a, b: a / b if a is not None and b else None  # noqa: E731
+    return [div(size.body_cm, size.height_cm), div(size.rim_cm, size.body_cm), div(size.foot_cm, size.body_cm)]
 
 
 @dataclass
@@ -70,57 +58,6 @@ class CatalogueReport:
     unmatched_rows: list[str]
 
 
-def _number(value: str, path: Path, line: int, column: str) -> float | None:
-    value = value.strip()
-    if not value:
-        return None
-    try:
-        number = float(value)
-    except ValueError:
-        raise InputError(f"{path}: line {line}: {column} is not a number ({value!r})") from None
-    if not math.isfinite(number) or number <= 0:
-        raise InputError(f"{path}: line {line}: {column} must be positive, got {value!r}")
-    return number
-
-
-def read_catalogue(path: str | Path) -> dict[str, CatalogueRow]:
-    """The rows of a tab-separated catalogue table with the columns `object` and DIMENSIONS (others ignored).
-
-    Raises:
-        InputError: missing, too large, a missing column, a repeated object id or a bad number.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: no such catalogue table")
-    if path.stat().st_size > MAX_TABLE_BYTES:
-        raise InputError(f"{path}: larger than {MAX_TABLE_BYTES // 2**20} MiB, not a catalogue table")
-    with open(path, newline="", encoding="utf-8") as f:
-        reader = csv.DictReader(f, delimiter="\t")
-        missing = [c for c in ("object", *DIMENSIONS) if c not in (reader.fieldnames or [])]
-        if missing:
-            raise InputError(f"{path}: missing column(s) {', '.join(missing)} (tab-separated, with a header)")
-        rows: dict[str, CatalogueRow] = {}
-        for line, row in enumerate(reader, start=2):
-            oid = (row["object"] or "").strip()
-            if not oid:
-                continue
-            if oid in rows:
-                raise InputError(f"{path}: line {line}: object {oid!r} listed twice")
-            rows[oid] = CatalogueRow(oid, *(_number(row[c] or "", path, line, c) for c in DIMENSIONS))
-    return rows
-
-
-def match(name: str, ids: list[str]) -> tuple[str, str] | None:
-    """(object id, view) of a result folder name: the longest id that is the whole name or followed by one of
-    SEPARATORS; None if none is."""
-    best = None
-    for oid in ids:
-        if name == oid or (name.startswith(oid) and name[len(oid)] in SEPARATORS):
-            if best is None or len(oid) > len(best):
-                best = oid
-    return None if best is None else (best, name[len(best) + 1 :])
-
-
 def _reference_iou(folder: Path, material: dict, silhouettes: Path, object_id: str, view: str) -> float | None:
     """IoU of the drawn silhouette with the reference one cut by the result's crop box (None: no reference)."""
     names = [folder.name] + ([f"{object_id}_{view}"] if view else [])
@@ -136,24 +73,25 @@ def _reference_iou(folder: Path, material: dict, silhouettes: Path, object_id: s
     return iou(drawn, window > 0.5)
 
 
-def measure(folder: Path, row: CatalogueRow, view: str, drawings: Path | None,
+def measure(folder: Path, object_id: str, view: str, size: ObjectSize, drawings: Path | None,
             silhouettes: Path | None) -> ResultRecord:
-    """One result folder against its catalogue row (problems recorded, not raised)."""
-    record = ResultRecord(folder.name, row.object_id, view)
+    """One result folder against its catalogue row (problems recorded, not raised); `object_id` as the folder's
+    name spells it (drawings and silhouettes are looked up by it)."""
+    record = ResultRecord(folder.name, object_id, view)
     try:
         material = read_json(folder / "material.json")
         record.status = str((material.get("quality") or {}).get("status", ""))
         record.pitch = float(material["pitch"])
         fitted = P.profile_from_material(material["radius"], float(material["height"]))
         record.fitted = list(P.ratios(*fitted).as_tuple())
-        record.catalogue = list(row.ratios())
+        record.catalogue = catalogue_ratios(size)
         record.error_pct = [None if c is None else abs(f - c) / c * 100.0
                             for f, c in zip(record.fitted, record.catalogue)]
-        drawing = None if drawings is None else drawings / f"{row.object_id}.csv"
+        drawing = None if drawings is None else drawings / f"{object_id}.csv"
         if drawing is not None and drawing.is_file():
             record.profile = P.profile_error(fitted, P.read_drawn_profile(drawing.read_text(encoding="utf-8")))
         if silhouettes is not None:
-            record.iou = _reference_iou(folder, material, silhouettes, row.object_id, view)
+            record.iou = _reference_iou(folder, material, silhouettes, object_id, view)
     except (OSError, KeyError, TypeError, ValueError, InputError) as e:
         record.problem = f"{type(e).__name__}: {e}"
     return record
@@ -162,25 +100,26 @@ def measure(folder: Path, row: CatalogueRow, view: str, drawings: Path | None,
 def evaluate_catalogue(results: str | Path, dimensions: str | Path, drawings: str | Path | None = None,
                        silhouettes: str | Path | None = None) -> CatalogueReport:
     """Every result folder under `results` matched to `dimensions`' rows and measured."""
-    rows = read_catalogue(dimensions)
+    table = read_size_table(dimensions)
     root = Path(results)
     if not root.is_dir():
         raise InputError(f"{root}: no such results folder")
     for folder, what in ((drawings, "--drawings"), (silhouettes, "--silhouettes")):
         if folder is not None and not Path(folder).is_dir():
             raise InputError(f"{folder}: {what} folder does not exist")
-    ids = sorted(rows)
     records, unmatched, seen = [], [], set()
     for paths in list_results(root):
-        found = match(paths.folder.name, ids)
+        name = paths.folder.name
+        found = table.match(name)
         if found is None:
-            unmatched.append(paths.folder.name)
+            unmatched.append(name)
             continue
-        seen.add(found[0])
-        records.append(measure(paths.folder, rows[found[0]], found[1], None if drawings is None else Path(drawings),
+        key, view = found
+        seen.add(key)
+        records.append(measure(paths.folder, name[: len(key)], view, table.sizes[key],
+                               None if drawings is None else Path(drawings),
                                None if silhouettes is None else Path(silhouettes)))
-    with_dimensions = [oid for oid in ids if rows[oid].height is not None]
-    return CatalogueReport(records, unmatched, [oid for oid in with_dimensions if oid not in seen])
+    return CatalogueReport(records, unmatched, [key for key in table.sizes if key not in seen])
 
 
 def _fmt(value: float | None, spec: str) -> str:
