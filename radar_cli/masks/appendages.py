@@ -26,6 +26,7 @@ END_ROWS = 0.04  # ... unless they reach this close (fraction of the height) to 
 MIN_APPENDAGE = 0.004  # appendage parts smaller than this fraction of the silhouette are outline noise
 SPIKE_WIDTH = 0.6  # rows above the rim narrower than this fraction of the rim's radius stand on it (a handle)
 SPIKE_SPAN = 0.2  # ... where the rim is the widest row within this fraction of the height from the top
+SHELF = 0.25  # ... and the rim widens from them in one row by at least this fraction of its radius
 
 
 @dataclass(frozen=True)
@@ -102,14 +103,15 @@ def _axis_runs(mask: np.ndarray, axis: float) -> tuple[np.ndarray, np.ndarray]:
 
 def _top_spike(radius: np.ndarray, limit: np.ndarray, rows: np.ndarray) -> np.ndarray:
     """`limit` (per-row half-width bound) with 0 on the rows above the rim narrower than SPIKE_WIDTH x its radius
-    (the widest row within SPIKE_SPAN of the top), if they span at least END_ROWS of the height: a part standing
-    on the rim (module docstring)."""
+    (the widest row within SPIKE_SPAN of the top), if they span at least END_ROWS of the height and the rim
+    widens from them in one row by SHELF of its radius: a part standing on the rim (module docstring)."""
     out = limit.copy()
     height = rows.max() - rows.min() + 1
     top, span = int(rows.min()), max(1, int(round(SPIKE_SPAN * height)))
     window = np.nan_to_num(radius[top : top + span], nan=0.0)
     spike = int(np.argmax(window >= SPIKE_WIDTH * window.max()))
-    if spike >= END_ROWS * height:  # shorter: the rim's own rounded top
+    # shorter: the rim's own rounded top; no shelf (the width grows gradually): a domed top, the solid's own
+    if spike >= END_ROWS * height and window[spike] - window[spike - 1] >= SHELF * window.max():
         out[top : top + spike] = 0.0
     return out
 
