@@ -83,10 +83,10 @@ def measure(folder: Path, object_id: str, view: str, size: ObjectSize, drawings:
         record.status = str((material.get("quality") or {}).get("status", ""))
         record.pitch = float(material["pitch"])
         fitted = P.profile_from_material(material["radius"], float(material["height"]))
-        record.fitted = list(P.ratios(*fitted).as_tuple())
+        ratios = P.ratios(*fitted).as_tuple()
+        record.fitted = list(ratios)
         record.catalogue = catalogue_ratios(size)
-        record.error_pct = [None if c is None else abs(f - c) / c * 100.0
-                            for f, c in zip(record.fitted, record.catalogue)]
+        record.error_pct = [None if c is None else abs(f - c) / c * 100.0 for f, c in zip(ratios, record.catalogue)]
         drawing = None if drawings is None else drawings / f"{object_id}.csv"
         if drawing is not None and drawing.is_file():
             record.profile = P.profile_error(fitted, P.read_drawn_profile(drawing.read_text(encoding="utf-8")))

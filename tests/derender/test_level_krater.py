@@ -4,7 +4,6 @@ as a steep view into the mouth."""
 
 from __future__ import annotations
 
-import cv2
 import numpy as np
 import pytest
 import torch

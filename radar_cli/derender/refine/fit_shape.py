@@ -212,7 +212,8 @@ def closed_form(target: Outline, size: int, pitches: torch.Tensor, roll: float, 
         d_top, d_bottom = top - drawn_top, bottom - drawn_bottom
         height = (height + (d_bottom - d_top) / 2 * unit / torch.cos(torch.deg2rad(pose[:, 0]))).clamp(0.3, 1.2)
         pose[:, 3] = pose[:, 3] - (d_top + d_bottom) / 2 * unit
-    return profile_from_widths(target, height, pose, config.rows, size, camera, config.end_px * size / 256), height, pose
+    radius = profile_from_widths(target, height, pose, config.rows, size, camera, config.end_px * size / 256)
+    return radius, height, pose
 
 
 def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
