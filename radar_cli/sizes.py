@@ -111,15 +111,25 @@ class SizeTable:
     def lookup(self, name: str, photo: Path | None = None) -> ObjectSize | None:
         """The size of the result `name` (`<id>` or `<id>_<view>`, the longest matching id), else of the folder
         the photo lies in (`<id>/<view>.jpg`); None if no id matches."""
-        key = name.casefold()
-        if key in self.sizes:
-            return self.sizes[key]
-        prefixed = [i for i in self.sizes if key.startswith(i + "_")]
-        if prefixed:
-            return self.sizes[max(prefixed, key=len)]
+        found = self.match(name)
+        if found is not None:
+            return self.sizes[found[0]]
         if photo is not None:
             return self.sizes.get(photo.parent.name.casefold())
         return None
+
+
+    def match(self, name: str) -> tuple[str, str] | None:
+        """(id key, view) of the result `name`: `<id>` (view '') or `<id>_<view>`, the longest matching id;
+        None if none matches."""
+        key = name.casefold()
+        if key in self.sizes:
+            return key, ""
+        prefixed = [i for i in self.sizes if key.startswith(i + "_")]
+        if not prefixed:
+            return None
+        best = max(prefixed, key=len)
+        return best, name[len(best) + 1 :]
 
 
 def read_size_table(path: str | Path) -> SizeTable:

@@ -26,6 +26,8 @@ COMMANDS: list[tuple[str, str, str, str]] = [
     ("serve", "radar_cli.cli.serve", "serve", "Show a results folder's gallery and 3D viewer at a local address."),
     ("relight", "radar_cli.cli.relight", "relight", "Re-render a de-rendered object under new light and view."),
     ("eval", "radar_cli.cli.eval", "eval_cmd", "Score de-rendering results against synthetic ground truth."),
+    ("eval-catalog", "radar_cli.cli.eval_catalog", "eval_catalog",
+     "Measure results of real photographs against a catalogue's dimensions and drawings."),
     ("eval-views", "radar_cli.cli.eval_views", "eval_views",
      "Score objects with several photos by predicting each side view from the others."),
     ("bench", "radar_cli.cli.bench", "bench", "Time a stage of the pipeline and print JSON."),

@@ -5,7 +5,8 @@ Each row of a solid of revolution seen from the side is one interval centred on 
 the core keeps the run of object pixels that holds the axis (the loop of a handle, seen beside the body, is
 another run), clipped to the shorter of its two half-widths (a spout sticks out on one side only) and to the
 row's radius after a vertical opening of the radius profile (a handle's attachment widens a few rows on both
-sides; the body's own curve is smooth over that span).
+sides; the body's own curve is smooth over that span). A narrow part standing on the rim (a volute or a
+handle's top seen face on, above the mouth) is an appendage too, though it reaches the top.
 """
 
 from __future__ import annotations
@@ -23,6 +24,9 @@ BUMP_SPAN = 0.1  # bumps of the radius profile shorter than this fraction of the
 NEAR_AXIS = 0.05  # a row whose runs all miss the axis keeps the nearest one within this fraction of the width
 END_ROWS = 0.04  # ... unless they reach this close (fraction of the height) to the top or bottom: a rim, a foot
 MIN_APPENDAGE = 0.004  # appendage parts smaller than this fraction of the silhouette are outline noise
+SPIKE_WIDTH = 0.6  # rows above the rim narrower than this fraction of the rim's radius stand on it (a handle)
+SPIKE_SPAN = 0.2  # ... where the rim is the widest row within this fraction of the height from the top
+SHELF = 0.25  # ... and the rim widens from them in one row by at least this fraction of its radius
 
 
 @dataclass(frozen=True)
@@ -97,6 +101,21 @@ def _axis_runs(mask: np.ndarray, axis: float) -> tuple[np.ndarray, np.ndarray]:
     return left, right
 
 
+def _top_spike(radius: np.ndarray, limit: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """`limit` (per-row half-width bound) with 0 on the rows above the rim narrower than SPIKE_WIDTH x its radius
+    (the widest row within SPIKE_SPAN of the top), if they span at least END_ROWS of the height and the rim
+    widens from them in one row by SHELF of its radius: a part standing on the rim (module docstring)."""
+    out = limit.copy()
+    height = rows.max() - rows.min() + 1
+    top, span = int(rows.min()), max(1, int(round(SPIKE_SPAN * height)))
+    window = np.nan_to_num(radius[top : top + span], nan=0.0)
+    spike = int(np.argmax(window >= SPIKE_WIDTH * window.max()))
+    # shorter: the rim's own rounded top; no shelf (the width grows gradually): a domed top, the solid's own
+    if spike >= END_ROWS * height and window[spike] - window[spike - 1] >= SHELF * window.max():
+        out[top : top + spike] = 0.0
+    return out
+
+
 def _opening(profile: np.ndarray, span: int) -> np.ndarray:
     """Grey opening of a 1-D profile (NaN = no object) with a window of `span` samples: peaks narrower than the
     window are cut down to their surroundings."""
@@ -131,9 +150,10 @@ def upright_core(mask: np.ndarray, axis: float) -> np.ndarray:
     radius = np.fmin(left, right)
     opened = _opening(radius, int(round(BUMP_SPAN * (rows.max() - rows.min() + 1))))
     limit = np.fmin(radius, _keep_ends(radius, opened, tol, rows)) + tol
+    limit = _top_spike(radius, limit, rows)
     xs = np.arange(mask.shape[1]) + 0.5 - (axis + 0.5)  # pixel centres relative to the axis
     core = np.zeros_like(mask)
-    for y in rows:
+    for y in rows[limit[rows] > 0]:
         core[y] = mask[y] & (xs >= -min(left[y], limit[y])) & (xs <= min(right[y], limit[y]))
     return main_component(core)
 

@@ -39,7 +39,17 @@ class ShapeFitConfig:
         pitch_max: the grids cover 0..pitch_max degrees.
         coarse_step, fine_step: the pitch grids (the fine one spans +- coarse_step round the coarse pick).
         roughness_weight: the profile's bending (sum of squared second differences x 1e3, at 64 rows).
+        corner: a second difference counts at most this much (a moulding, a lip, a foot's step is a corner of a
+            real profile: charged once, whatever its size; None: no cap). Uncapped, the steps of an overhanging
+            rim and a stepped foot, sharp at the right (level) pitch, are smoothed by the ellipses of a steep
+            one, and the bending term drove level photographs of kraters to 10-25 deg.
         basin: the lip may pick any candidate whose outline score is within this of the best.
+        cue_basin_px: the lip and the bands pick only among candidates whose top edge (the rim's back arc
+            where the mouth shows) is within this of the best one's (px at grid_size; None: no such bound):
+            where the photograph's top edge is straight, the rim is seen edge on and no mouth is drawn, whatever
+            edge or pattern below it looks like a lip.
+        end_px: the profile's end rows are read at least this far (px at 256) inside the outline's first and
+            last rows (profile_from_widths).
         lip_contrast: the lip is trusted where its contrast (grey levels 0..1) exceeds this.
         band_ratio: painted bands pick the pitch where their coherence peaks at least this many times its lowest
             over the grid.
@@ -64,7 +74,10 @@ class ShapeFitConfig:
     coarse_step: float = 0.5
     fine_step: float = 0.1
     roughness_weight: float = 0.5
+    corner: float | None = 0.005
     basin: float = 3.0
+    cue_basin_px: float | None = 1.0
+    end_px: float = 2.0
     lip_contrast: float = 0.1
     lip_tie: float = 0.9
     prior_reach: float = 3.0
@@ -119,9 +132,13 @@ def outline_score(model: Outline, target: Outline, absolute: bool = False) -> to
     return total / count.clamp_min(1)
 
 
-def roughness(radius: torch.Tensor) -> torch.Tensor:
-    """B bending energies of B x L profiles: sum of squared second differences, x 1e3, scaled to 64 rows."""
+def roughness(radius: torch.Tensor, corner: float | None = None) -> torch.Tensor:
+    """B bending energies of B x L profiles: sum of squared second differences (each at most corner^2 where a
+    corner is given), x 1e3, scaled to 64 rows."""
     d2 = radius[:, 2:] - 2 * radius[:, 1:-1] + radius[:, :-2]
+    if corner is not None:
+        cap = corner * (64 / radius.shape[1]) ** 2  # a smooth curve's second differences scale with 1 / L^2
+        d2 = d2.clamp(-cap, cap)
     return (d2**2).sum(1) * 1e3 * (radius.shape[1] / 64) ** 3
 
 
@@ -157,14 +174,19 @@ def _disc_centres(height: torch.Tensor, pose: torch.Tensor, rows: int, camera: C
 
 
 def profile_from_widths(target: Outline, height: torch.Tensor, pose: torch.Tensor, rows: int, size: int,
-                        camera: CameraConfig) -> torch.Tensor:
+                        camera: CameraConfig, end_px: float = 0.0) -> torch.Tensor:
     """B x rows radius column read off the target's row widths: each disc's radius is the half-width of the
-    image row its centre projects to, scaled back by its depth (exact for a cylinder seen side on)."""
+    image row its centre projects to, scaled back by its depth (exact for a cylinder seen side on). Rows within
+    end_px of the outline's first and last are read at that distance: an end disc seen nearly edge on projects
+    onto the outline's first or last row, whose width the located silhouette's rounded corners shorten."""
     valid = torch.nonzero(~target.left[0].isnan()).flatten()
     half = ((target.right[0] - target.left[0]) / 2)[valid]
     centre = _disc_centres(height, pose, rows, camera)
     tan = _tan(camera)
     row = (1 - centre[..., 1] / centre[..., 2] / tan) * size / 2 - 0.5
+    first, last = float(valid.min()), float(valid.max())
+    if last - first > 4 * end_px:
+        row = row.clamp(first + end_px, last - end_px)
     width = np.interp(row.numpy().ravel(), valid.numpy(), half.numpy()).reshape(row.shape)
     radius = torch.from_numpy(width) * (2 / size) * centre[..., 2] * tan / camera.r_max
     return radius.clamp(0.05, 0.9)
@@ -185,12 +207,13 @@ def closed_form(target: Outline, size: int, pitches: torch.Tensor, roll: float, 
     top, bottom = np.nanmin(target.top[0].numpy()), np.nanmax(target.bottom[0].numpy())
     unit = 2.0 / size  # r_max fractions per pixel at the object's distance
     for _ in range(config.placement_iterations):
-        radius = profile_from_widths(target, height, pose, config.rows, size, camera)
+        radius = profile_from_widths(target, height, pose, config.rows, size, camera, config.end_px * size / 256)
         drawn_top, drawn_bottom = vertical_extent(Solid(radius, height, pose), size, camera)
         d_top, d_bottom = top - drawn_top, bottom - drawn_bottom
         height = (height + (d_bottom - d_top) / 2 * unit / torch.cos(torch.deg2rad(pose[:, 0]))).clamp(0.3, 1.2)
         pose[:, 3] = pose[:, 3] - (d_top + d_bottom) / 2 * unit
-    return profile_from_widths(target, height, pose, config.rows, size, camera), height, pose
+    radius = profile_from_widths(target, height, pose, config.rows, size, camera, config.end_px * size / 256)
+    return radius, height, pose
 
 
 def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
@@ -227,23 +250,42 @@ def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor,
 
 
 def _search(target: Outline, grey: torch.Tensor, size: int, pitches: torch.Tensor, roll: float, tx: float,
-            config: ShapeFitConfig, camera: CameraConfig,
-            lip_offset_px: float) -> tuple[tuple[torch.Tensor, torch.Tensor, torch.Tensor], torch.Tensor, torch.Tensor]:
-    """Score a grid of candidate pitches: (shapes, outline + bending scores B, lip contrasts B)."""
+            config: ShapeFitConfig, camera: CameraConfig, lip_offset_px: float
+            ) -> tuple[tuple[torch.Tensor, torch.Tensor, torch.Tensor], torch.Tensor, torch.Tensor, torch.Tensor,
+                       torch.Tensor]:
+    """Score a grid of candidate pitches: (shapes, outline + bending scores B, lip contrasts B, top-edge
+    errors B, outline + uncapped bending B)."""
     radius, height, pose = closed_form(target, size, pitches, roll, tx, config, camera)
-    score = outline_score(outline(Solid(radius, height, pose), size, camera), target)
-    score = score + config.roughness_weight * roughness(radius)
-    return (radius, height, pose), score, lip_contrast(grey, radius, height, pose, lip_offset_px, camera)
+    drawn = outline(Solid(radius, height, pose), size, camera)
+    fit = outline_score(drawn, target)
+    score = fit + config.roughness_weight * roughness(radius, config.corner)
+    smooth = fit + config.roughness_weight * roughness(radius)
+    return ((radius, height, pose), score, lip_contrast(grey, radius, height, pose, lip_offset_px, camera),
+            top_error(drawn, target), smooth)
+
+
+def top_error(model: Outline, target: Outline) -> torch.Tensor:
+    """B mean |distances| (px) between the top ends of a batch of outlines and the target's, over the columns
+    both cover: how well each candidate's rim (its back arc, where the mouth shows) draws the photograph's top
+    edge."""
+    both = ~(model.top.isnan() | target.top.isnan())
+    diff = torch.where(both, (model.top - target.top.expand_as(model.top)).abs(), torch.zeros_like(model.top))
+    return diff.sum(1) / both.sum(1).clamp_min(1)
 
 
 def _pick(score: torch.Tensor, contrast: torch.Tensor, coherence: torch.Tensor | None, pitches: torch.Tensor,
-          config: ShapeFitConfig) -> tuple[int, str]:
-    """The cue that picks among candidates B (all within the outline's basin):
+          config: ShapeFitConfig, top: torch.Tensor | None = None,
+          smooth: torch.Tensor | None = None) -> tuple[int, str]:
+    """The cue that picks among candidates B (all within the outline's basin, and within config.cue_basin_px
+    of the best top edge, `top`, where given):
     - painted bands, where their coherence peaks at least config.band_ratio x its lowest: they bound the lip's
       search to config.band_reach of their peak (an edge above or below the rim can pass for it);
-    - the strongest lip if that lip is strong enough (the best outline among near-ties);
+    - the strongest lip if that lip is strong enough (among near-ties, the best outline with the bending
+      uncapped, `smooth`, where given: two arcs as strong, the smoother profile);
     - else the bands' peak, else the best outline score."""
     basin = score <= score.min() + config.basin
+    if top is not None and config.cue_basin_px is not None:
+        basin = basin & (top <= top.min() + config.cue_basin_px)
     band = None
     if coherence is not None:
         peaks = torch.where(basin, coherence, torch.full_like(coherence, -math.inf))
@@ -254,7 +296,8 @@ def _pick(score: torch.Tensor, contrast: torch.Tensor, coherence: torch.Tensor |
     if float(lips.max()) > config.lip_contrast:
         # several arcs as strong as the best (an edge inside the mouth that many arcs cross): the outline decides
         strong = lips >= config.lip_tie * lips.max()
-        return int(torch.where(strong, score, torch.full_like(score, math.inf)).argmin()), "lip"
+        tie = score if smooth is None else smooth
+        return int(torch.where(strong, tie, torch.full_like(tie, math.inf)).argmin()), "lip"
     if band is not None:
         return band, "band"
     return int(score.argmin()), "outline"
@@ -272,9 +315,10 @@ def search_pitch(target: Outline, grey: torch.Tensor, size: int, config: ShapeFi
     middle of the range, so it reads the low pitches where the mouth is a sliver too high."""
     roll, tx = axis_from_outline(target, size, camera)
     coarse = torch.arange(0.0, config.pitch_max + 1e-6, config.coarse_step, dtype=torch.float64)
-    shapes, score, contrast = _search(target, grey, size, coarse, roll, tx, config, camera, config.lip_offset_px)
+    shapes, score, contrast, top, smooth = _search(target, grey, size, coarse, roll, tx, config, camera,
+                                                   config.lip_offset_px)
     coherence = None if bands is None else band_coherence(bands[0], bands[1], *shapes, config.bands, camera)
-    best, cue = _pick(score, contrast, coherence, coarse, config)
+    best, cue = _pick(score, contrast, coherence, coarse, config, top, smooth)
     if cue == "outline" and prior_pitch is not None:
         near = coarse - prior_pitch <= config.prior_reach
         if near.any():
@@ -282,7 +326,7 @@ def search_pitch(target: Outline, grey: torch.Tensor, size: int, config: ShapeFi
     centre = float(coarse[best])
     fine = torch.arange(centre - config.coarse_step, centre + config.coarse_step + 1e-6, config.fine_step,
                         dtype=torch.float64).clamp(0.0, config.pitch_max)
-    shapes, score, contrast = _search(target, grey, size, fine, roll, tx, config, camera, config.fine_lip_offset_px)
+    shapes, score, contrast, *_ = _search(target, grey, size, fine, roll, tx, config, camera, config.fine_lip_offset_px)
     best = int(contrast.argmax()) if cue == "lip" else int(score.argmin())  # bands place no finer than the outline
     return tuple(t[best : best + 1] for t in shapes), cue
 
@@ -306,7 +350,7 @@ def polish(target: Outline, size: int, radius: torch.Tensor, height: torch.Tenso
         opt.zero_grad()
         r, h, p = unpack(x)
         drawn = outline(Solid(r, h, p), size, camera)
-        loss = (outline_score(drawn, target) + config.roughness_weight * roughness(r)).sum()
+        loss = (outline_score(drawn, target) + config.roughness_weight * roughness(r, config.corner)).sum()
         loss.backward()
         opt.step()
     return unpack(x.detach())
@@ -332,7 +376,8 @@ def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = Shape
     bands = high_pass(grey, mask, config.bands.sigma_px)
     (radius, height, pose), cue = search_pitch(coarse_target, grey_t, grid, config, camera, prior_pitch, bands)
     target = mask_outline(np.asarray(mask, np.float64))
-    radius = correct_widths(target, size, radius, height, pose, config.width_rounds, camera)
+    radius = correct_widths(target, size, radius, height, pose, config.width_rounds, camera,
+                            config.end_px * size / 256)
     for level, steps in zip((grid, size), config.polish_steps):
         level_target = coarse_target if level == grid else target
         radius, height, pose = polish(level_target, level, radius, height, pose, steps, config, camera)
@@ -341,17 +386,20 @@ def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = Shape
 
 
 def correct_widths(target: Outline, size: int, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
-                   rounds: int, camera: CameraConfig) -> torch.Tensor:
+                   rounds: int, camera: CameraConfig, end_px: float = 0.0) -> torch.Tensor:
     """The profile rescaled row by row so that the drawn outline's width matches the target's at the image row
     of each disc's centre (this takes in the limb's offset on sloping walls and the perspective, which
-    profile_from_widths ignores). B x L."""
+    profile_from_widths ignores; the end rows are read end_px inside, as there). B x L."""
     target_width = (target.right - target.left)[0].numpy()
+    covered = np.nonzero(np.isfinite(target_width))[0]
     tan = _tan(camera)
     for _ in range(rounds):
         drawn = outline(Solid(radius, height, pose), size, camera)
         width = (drawn.right - drawn.left).numpy()  # B x S
         centre = _disc_centres(height, pose, radius.shape[1], camera)
         row = ((1 - centre[..., 1] / centre[..., 2] / tan) * size / 2 - 0.5).numpy()
+        if len(covered) and covered[-1] - covered[0] > 4 * end_px:
+            row = np.clip(row, covered[0] + end_px, covered[-1] - end_px)
         ratio = target_width[None] / np.maximum(width, 1.0)
         for b in range(len(radius)):
             ok = np.isfinite(ratio[b]) & (width[b] >= 1.0)
