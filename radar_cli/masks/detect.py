@@ -31,6 +31,9 @@ SEED_SHARE = 0.5  # the backdrop's colour surface is refitted to this best-fitti
 SEED_ROUNDS = 3  # ... this many times
 SEED_MIN_TOLERANCE = 8.0  # band pixels this close (RGB levels) to that surface are backdrop whatever its spread
 LIGHT_RANGE = (0.2, 1.6)  # brightness ratios to the backdrop model that shading of the backdrop can explain
+GREY_SPREAD = 4.0  # a photo whose channels differ by less than this (levels) almost everywhere is greyscale
+BAND_SEGMENTS = 8  # each side of the border band is judged in this many segments ...
+BAND_TOLERANCE = 14.0  # ... a segment is backdrop if its median colour is this close (levels) to the backdrop's
 
 
 @dataclass(frozen=True)
@@ -138,6 +141,46 @@ def harmonic_fill(values: np.ndarray, known: np.ndarray, grid: int = 40, iterati
     return out.reshape(h, w, -1)
 
 
+def _segments(shape: tuple[int, int], band: np.ndarray) -> list[np.ndarray]:
+    """The border band cut into BAND_SEGMENTS pieces per side (index arrays into the flattened image)."""
+    h, w = shape
+    ys, xs = np.nonzero(band)
+    k = max(2, round(BORDER_FRAC * max(h, w)))
+    side = np.where(ys < k, 0, np.where(ys >= h - k, 1, np.where(xs < k, 2, 3)))
+    along = np.where(side < 2, xs / max(w, 1), ys / max(h, 1))
+    piece = side * BAND_SEGMENTS + np.minimum((along * BAND_SEGMENTS).astype(int), BAND_SEGMENTS - 1)
+    flat = ys * w + xs
+    return [flat[piece == i] for i in range(4 * BAND_SEGMENTS) if (piece == i).any()]
+
+
+def backdrop_band(image: np.ndarray, band: np.ndarray | None = None) -> np.ndarray:
+    """H x W bool: the border band's pieces that show backdrop. An object touching up to three edges fills
+    many pieces of the band, each of its own colours; the backdrop is the largest set of pieces whose median
+    colours agree, grown by the ones a linear colour gradient through that set explains (a sweep).
+
+    Args:
+        image: H x W x 3 uint8 RGB. band: H x W bool (default: the border band).
+    """
+    band = border_band(image.shape[:2]) if band is None else band
+    h, w = band.shape
+    pieces = _segments((h, w), band)
+    flat = image.reshape(-1, 3).astype(np.float32)
+    colours = np.array([np.median(flat[p], axis=0) for p in pieces])  # P x 3
+    centres = np.array([[(p % w).mean() / w, (p // w).mean() / h] for p in pieces])  # P x 2
+    close = np.linalg.norm(colours[:, None] - colours[None], axis=2) < BAND_TOLERANCE
+    chosen = close[int(np.argmax(close.sum(1)))]
+    design = np.column_stack([np.ones(len(pieces)), centres])  # P x 3: a linear gradient
+    for _ in range(2):
+        coef, *_ = np.linalg.lstsq(design[chosen], colours[chosen], rcond=None)
+        chosen = np.linalg.norm(colours - design @ coef, axis=1) < BAND_TOLERANCE
+        if chosen.sum() < 2:
+            return band
+    out = np.zeros(h * w, bool)
+    for p, keep in zip(pieces, chosen):
+        out[p] = keep
+    return out.reshape(h, w)
+
+
 def backdrop_distance(image: np.ndarray, band: np.ndarray) -> np.ndarray:
     """H x W distance of each pixel from the fitted backdrop, in units of the border noise.
 
@@ -158,6 +201,8 @@ def backdrop_distance(image: np.ndarray, band: np.ndarray) -> np.ndarray:
     # band-pass detail: object outlines and surface texture have it, soft shadow edges and light pools do not
     texture = cv2.GaussianBlur(np.abs(grey - cv2.GaussianBlur(grey, (0, 0), 1.5)), (0, 0), 2.0) / noise.mean()
     lighting = (ratio > LIGHT_RANGE[0]) & (ratio < LIGHT_RANGE[1])
+    if np.quantile(np.ptp(smooth, axis=2), 0.98) < GREY_SPREAD:  # greyscale: brightness is all there is
+        return dist
     return np.where(lighting, np.minimum(dist, 1.5 * chroma + 3.0 * texture), dist)
 
 
@@ -190,7 +235,7 @@ def foreground_evidence(image: np.ndarray, band: np.ndarray | None = None) -> np
         image: H x W x 3 uint8 RGB.
         band: H x W bool, the pixels the backdrop is modelled from (default: the border band).
     """
-    band = border_band(image.shape[:2]) if band is None else band
+    band = backdrop_band(image) if band is None else band
     dist = backdrop_distance(image, band)
     colour = 1.0 - np.exp(-((dist / 6.0) ** 2))  # ~0.63 at 6 sigma
     extra = 0.25 * edge_map(image).clip(0, 1) + 0.15 * saliency_map(image)
@@ -238,7 +283,7 @@ def backdrop_seeds(image: np.ndarray) -> np.ndarray:
     Args:
         image: H x W x 3 uint8 RGB.
     """
-    band = border_band(image.shape[:2])
+    band = backdrop_band(image)
     h, w = band.shape
     ys, xs = np.nonzero(band)
     a = _design(xs / max(w - 1, 1) * 2 - 1.0, ys / max(h - 1, 1) * 2 - 1.0).astype(np.float64)  # N x 6
@@ -336,7 +381,7 @@ def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) ->
         # (vignettes, light pools, a stand's surroundings), and cut again
         clear = ~(cv2.dilate(_clean(raw).astype(np.uint8), _square(RING * max(raw.shape))) > 0)
         if clear.mean() > RING:
-            evidence = foreground_evidence(small, clear | border_band(raw.shape))
+            evidence = foreground_evidence(small, clear | backdrop_band(small))
             raw = coarse_grabcut(small, evidence, threshold)
     mask = _clean(raw)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)

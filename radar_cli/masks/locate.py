@@ -13,6 +13,7 @@ import numpy as np
 from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
 from radar_cli.masks.appendages import Core, find_axis, symmetric_core, upright_rotation
+from radar_cli.masks.neighbours import split_neighbour
 from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fit_backdrop
 from radar_cli.masks.pipeline import Refined, Settings, check_photo, refine_detection, refine_window
 from radar_cli.masks.refine import main_component
@@ -42,6 +43,7 @@ class Located:
         frame_coverage: share of the photo the located object covers.
         symmetry: solid-of-revolution score of the core.
         stand_removed: whether a stand under the vessel was cut off.
+        neighbour_removed: whether a neighbouring object merged into the vessel was cut off.
     """
 
     image: np.ndarray
@@ -52,6 +54,7 @@ class Located:
     frame_coverage: float
     symmetry: float
     stand_removed: bool = False
+    neighbour_removed: bool = False
 
     @property
     def appendage_fraction(self) -> float:
@@ -211,7 +214,8 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
             raise InputError(f"{name}: no object stands out from the backdrop; crop it square or use --crop none")
         found = detections[0]
         refined = refine_detection(rgb, found, settings)
-    mask, stand = remove_stand(open_gaps(refined.mask, refined.image), refined.image)
+    mask, neighbour = split_neighbour(refined.mask)
+    mask, stand = remove_stand(open_gaps(mask, refined.image), refined.image)
     split: Core = symmetric_core(mask)
     final, image, core = refined.framed(rgb, split.core, settings, fill=255)  # beyond the frame: white
     _, _, whole = refined.framed(rgb, mask, settings, box_mask=split.core)
@@ -219,4 +223,4 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     k = refined.window.side / mask.shape[0]
     coverage = float(mask.sum() * k * k / (rgb.shape[0] * rgb.shape[1]))
     return Located(image, core, whole & ~core, final, crops.cut_edges(whole, region), min(1.0, coverage),
-                   split.symmetry, stand)
+                   split.symmetry, stand, neighbour)
