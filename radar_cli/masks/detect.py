@@ -19,8 +19,9 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from radar_cli.masks.border import backdrop_band, frame_padding
+
 WORK_SIDE = 320  # detection runs at this long edge; refinement happens later at crop resolution
-BORDER_FRAC = 0.04  # width of the border band the backdrop is fitted to, as a fraction of the long edge
 MIN_AREA_FRAC = 0.01  # components smaller than this fraction of the image are noise (labels, dust)
 MIN_REL_AREA = 0.2  # ... and components smaller than this fraction of the largest one are dropped too
 GROUP_GAP = 0.03  # components whose boxes come this close (fraction of the long edge) are one object ...
@@ -32,8 +33,6 @@ SEED_ROUNDS = 3  # ... this many times
 SEED_MIN_TOLERANCE = 8.0  # band pixels this close (RGB levels) to that surface are backdrop whatever its spread
 LIGHT_RANGE = (0.2, 1.6)  # brightness ratios to the backdrop model that shading of the backdrop can explain
 GREY_SPREAD = 4.0  # a photo whose channels differ by less than this (levels) almost everywhere is greyscale
-BAND_SEGMENTS = 8  # each side of the border band is judged in this many segments ...
-BAND_TOLERANCE = 14.0  # ... a segment is backdrop if its median colour is this close (levels) to the backdrop's
 
 
 @dataclass(frozen=True)
@@ -65,15 +64,6 @@ def downscale(image: np.ndarray, long_side: int = WORK_SIDE) -> tuple[np.ndarray
     h, w = (max(1, round(s * scale)) for s in image.shape[:2])
     interp = cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR
     return cv2.resize(image, (w, h), interpolation=interp), scale
-
-
-def border_band(shape: tuple[int, int], frac: float = BORDER_FRAC) -> np.ndarray:
-    """H x W bool, True in a band along the image border `frac` of the long edge wide (at least 2 px)."""
-    h, w = shape
-    k = max(2, round(frac * max(h, w)))
-    band = np.zeros((h, w), bool)
-    band[:k], band[-k:], band[:, :k], band[:, -k:] = True, True, True, True
-    return band
 
 
 def _design(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
@@ -141,46 +131,6 @@ def harmonic_fill(values: np.ndarray, known: np.ndarray, grid: int = 40, iterati
     return out.reshape(h, w, -1)
 
 
-def _segments(shape: tuple[int, int], band: np.ndarray) -> list[np.ndarray]:
-    """The border band cut into BAND_SEGMENTS pieces per side (index arrays into the flattened image)."""
-    h, w = shape
-    ys, xs = np.nonzero(band)
-    k = max(2, round(BORDER_FRAC * max(h, w)))
-    side = np.where(ys < k, 0, np.where(ys >= h - k, 1, np.where(xs < k, 2, 3)))
-    along = np.where(side < 2, xs / max(w, 1), ys / max(h, 1))
-    piece = side * BAND_SEGMENTS + np.minimum((along * BAND_SEGMENTS).astype(int), BAND_SEGMENTS - 1)
-    flat = ys * w + xs
-    return [flat[piece == i] for i in range(4 * BAND_SEGMENTS) if (piece == i).any()]
-
-
-def backdrop_band(image: np.ndarray, band: np.ndarray | None = None) -> np.ndarray:
-    """H x W bool: the border band's pieces that show backdrop. An object touching up to three edges fills
-    many pieces of the band, each of its own colours; the backdrop is the largest set of pieces whose median
-    colours agree, grown by the ones a linear colour gradient through that set explains (a sweep).
-
-    Args:
-        image: H x W x 3 uint8 RGB. band: H x W bool (default: the border band).
-    """
-    band = border_band(image.shape[:2]) if band is None else band
-    h, w = band.shape
-    pieces = _segments((h, w), band)
-    flat = image.reshape(-1, 3).astype(np.float32)
-    colours = np.array([np.median(flat[p], axis=0) for p in pieces])  # P x 3
-    centres = np.array([[(p % w).mean() / w, (p // w).mean() / h] for p in pieces])  # P x 2
-    close = np.linalg.norm(colours[:, None] - colours[None], axis=2) < BAND_TOLERANCE
-    chosen = close[int(np.argmax(close.sum(1)))]
-    design = np.column_stack([np.ones(len(pieces)), centres])  # P x 3: a linear gradient
-    for _ in range(2):
-        coef, *_ = np.linalg.lstsq(design[chosen], colours[chosen], rcond=None)
-        chosen = np.linalg.norm(colours - design @ coef, axis=1) < BAND_TOLERANCE
-        if chosen.sum() < 2:
-            return band
-    out = np.zeros(h * w, bool)
-    for p, keep in zip(pieces, chosen):
-        out[p] = keep
-    return out.reshape(h, w)
-
-
 def backdrop_distance(image: np.ndarray, band: np.ndarray) -> np.ndarray:
     """H x W distance of each pixel from the fitted backdrop, in units of the border noise.
 
@@ -233,7 +183,8 @@ def foreground_evidence(image: np.ndarray, band: np.ndarray | None = None) -> np
 
     Args:
         image: H x W x 3 uint8 RGB.
-        band: H x W bool, the pixels the backdrop is modelled from (default: the border band).
+        band: H x W bool, the pixels the backdrop is modelled from (default: the border pixels that show
+            backdrop, `backdrop_band`).
     """
     band = backdrop_band(image) if band is None else band
     dist = backdrop_distance(image, band)
@@ -242,7 +193,8 @@ def foreground_evidence(image: np.ndarray, band: np.ndarray | None = None) -> np
     return np.clip(colour + extra * (colour > 0.15), 0.0, 1.0)
 
 
-def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float) -> np.ndarray:
+def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float,
+                   band: np.ndarray | None = None) -> np.ndarray:
     """H x W bool object pixels of a detection-scale photo: GrabCut over the whole image, started from the
     evidence (above `threshold`, holes filled: probable object; a thin ring around it: probable backdrop; beyond
     it and `backdrop_seeds` in the border band: sure backdrop). Falls back to the thresholded evidence if
@@ -250,6 +202,7 @@ def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float) ->
 
     Args:
         image: H x W x 3 uint8 RGB. evidence: H x W in [0, 1] (`foreground_evidence`).
+        band: H x W bool, the border pixels that show backdrop (default: `backdrop_band`).
     """
     raw = evidence > threshold
     if not raw.any():
@@ -259,7 +212,7 @@ def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float) ->
     tri = np.full(raw.shape, cv2.GC_BGD, np.uint8)  # GrabCut trims what the evidence took, it never adds
     tri[reach] = cv2.GC_PR_BGD
     tri[seed] = cv2.GC_PR_FGD
-    tri[backdrop_seeds(image)] = cv2.GC_BGD
+    tri[backdrop_seeds(image, band)] = cv2.GC_BGD
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
     cv2.setRNGSeed(0)  # GrabCut's k-means draws from a per-thread generator: the same cut in any thread
     try:
@@ -275,15 +228,16 @@ def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float) ->
     return raw if broken else cut
 
 
-def backdrop_seeds(image: np.ndarray) -> np.ndarray:
+def backdrop_seeds(image: np.ndarray, band: np.ndarray | None = None) -> np.ndarray:
     """H x W bool border-band pixels that are surely backdrop: those that a quadratic colour surface, fitted to
     the band's best-fitting half, explains. An object running into the band is the minority there and is left
     out, even where the border model (which carries the whole band's residuals inwards) took it for backdrop.
 
     Args:
-        image: H x W x 3 uint8 RGB.
+        image: H x W x 3 uint8 RGB. band: H x W bool, the border pixels that show backdrop (default:
+            `backdrop_band`).
     """
-    band = backdrop_band(image)
+    band = backdrop_band(image) if band is None else band
     h, w = band.shape
     ys, xs = np.nonzero(band)
     a = _design(xs / max(w - 1, 1) * 2 - 1.0, ys / max(h - 1, 1) * 2 - 1.0).astype(np.float64)  # N x 6
@@ -375,14 +329,16 @@ def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) ->
         Detections, largest first; empty if nothing stands out from the backdrop.
     """
     small, scale = downscale(image)
-    evidence = foreground_evidence(small)
-    raw = coarse_grabcut(small, evidence, threshold)
+    padding = frame_padding(small)  # a flat frame round the picture: it must not join the object to its edges
+    band = backdrop_band(small) & ~padding
+    evidence = foreground_evidence(small, band)
+    raw = coarse_grabcut(small, evidence, threshold, band) & ~padding
     if thorough and raw.any():  # model the backdrop again from all round the object, not only the border
         # (vignettes, light pools, a stand's surroundings), and cut again
         clear = ~(cv2.dilate(_clean(raw).astype(np.uint8), _square(RING * max(raw.shape))) > 0)
         if clear.mean() > RING:
-            evidence = foreground_evidence(small, clear | backdrop_band(small))
-            raw = coarse_grabcut(small, evidence, threshold)
+            evidence = foreground_evidence(small, (clear | band) & ~padding)
+            raw = coarse_grabcut(small, evidence, threshold, band) & ~padding
     mask = _clean(raw)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     if n <= 1:

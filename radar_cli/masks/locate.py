@@ -13,7 +13,7 @@ import numpy as np
 from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
 from radar_cli.masks.appendages import Core, find_axis, symmetric_core, upright_rotation
-from radar_cli.masks.neighbours import split_neighbour
+from radar_cli.masks.neighbours import base_off_axis, split_neighbour
 from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fit_backdrop
 from radar_cli.masks.pipeline import Refined, Settings, check_photo, refine_detection, refine_window
 from radar_cli.masks.refine import main_component
@@ -44,6 +44,8 @@ class Located:
         symmetry: solid-of-revolution score of the core.
         stand_removed: whether a stand under the vessel was cut off.
         neighbour_removed: whether a neighbouring object merged into the vessel was cut off.
+        base_off_axis: share of the lowest rows of the located object off its symmetric core (a neighbour
+            probably kept with it where large; `neighbours.base_off_axis`).
     """
 
     image: np.ndarray
@@ -55,6 +57,7 @@ class Located:
     symmetry: float
     stand_removed: bool = False
     neighbour_removed: bool = False
+    base_off_axis: float = 0.0
 
     @property
     def appendage_fraction(self) -> float:
@@ -223,4 +226,4 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     k = refined.window.side / mask.shape[0]
     coverage = float(mask.sum() * k * k / (rgb.shape[0] * rgb.shape[1]))
     return Located(image, core, whole & ~core, final, crops.cut_edges(whole, region), min(1.0, coverage),
-                   split.symmetry, stand, neighbour)
+                   split.symmetry, stand, neighbour, base_off_axis(mask, split.core))

@@ -2,7 +2,9 @@
 beside it): the columns' extent over the lower part of the object rises a second time beyond the main vessel's
 flank; the object is cut at the valley between the two humps and the main (larger) one is kept.
 
-Handles and rims reach out above the body, not down to the floor: only the lower rows are read.
+Handles and rims reach out above the body, not down to the floor: only the lower rows are read. Where no
+valley parts them (a vessel behind overlapping the main one by much of its width), what lies off the main
+vessel's symmetric core in the lowest rows (`base_off_axis`) says a neighbour was probably kept with it.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ LOWER = 0.55  # the column profile counts object pixels in this lower share of t
 SECOND_PEAK = 0.3  # a second hump at least this fraction of the main one's height is a neighbour ...
 VALLEY = 0.6  # ... when the profile between them drops below this fraction of the second hump
 MIN_PART = 0.05  # ... and the part beyond the valley holds at least this share of the object
+BASE = 0.4  # `base_off_axis` reads this lowest share of the object's rows
 
 
 def _valley(profile: np.ndarray, start: int, step: int) -> int | None:
@@ -58,3 +61,19 @@ def split_neighbour(mask: np.ndarray) -> tuple[np.ndarray, bool]:
             out &= ~beyond
             cut = True
     return (main_component(out), True) if cut else (mask, False)
+
+
+def base_off_axis(whole: np.ndarray, core: np.ndarray) -> float:
+    """Share of the located object's lowest BASE rows that lies off its symmetric core: near 0 for a vessel
+    (its foot and body are symmetric, handles sit higher), large where a neighbour standing beside or behind
+    it (or a card in front of its foot) was kept with it.
+
+    Args:
+        whole: n x n bool located object (core and appendages). core: n x n bool, its symmetric core.
+    """
+    rows = np.nonzero(whole.any(1))[0]
+    if len(rows) < 2:
+        return 0.0
+    low = whole.copy()
+    low[: rows.max() + 1 - int(BASE * (rows.max() - rows.min() + 1))] = False
+    return float((low & ~core).sum() / max(int(low.sum()), 1))

@@ -36,6 +36,8 @@ def test_a_good_result_is_ok() -> None:
     ({"recon_psnr": 8.0}, "review", "far from the photo"),
     ({"cut_edges": ["top", "bottom", "left"]}, "review", "3 photo edges"),
     ({"outline_support": 0.4}, "review", "off the object's edge"),
+    ({"neighbour_cut": True}, "review", "neighbouring object was cut away"),
+    ({"base_off_axis": 0.3}, "review", "another object probably merged"),
     ({"silhouette_iou": None, "symmetry": None, "silhouette_area": None}, "review", "no silhouette"),
 ])
 def test_each_score_can_demote(change: dict, status: str, words: str) -> None:

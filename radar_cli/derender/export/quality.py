@@ -70,6 +70,9 @@ class QualityLimits:
     """More than this share of the object drawn much brighter than the photo: review (invented highlights)."""
     review_colour: float = 15.0
     """The reconstruction's mean chroma further than this from the photo's (CIELAB): review."""
+    review_base_off_axis: float = 0.1
+    """More than this share of the located object's lowest rows off its symmetric core (`base_off_axis`):
+    review (a neighbouring object, or a card in front of the foot, probably kept with it)."""
 
 
 def psnr(a: np.ndarray, b: np.ndarray) -> float:
@@ -141,6 +144,8 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
         "appendage_fraction": (None if app is None or whole is None or not whole.any()
                                else _round(float(app.sum()) / whole.sum())),
         "silhouette_area": None if sil is None else _round(float(sil.mean())),
+        "neighbour_cut": prepared.neighbour_cut,
+        "base_off_axis": _round(prepared.base_off_axis),
     }
 
 
@@ -173,6 +178,7 @@ def judge(record: dict, limits: QualityLimits = QualityLimits()) -> tuple[str, l
     review += likeness_reasons(record, limits)
     if len(record.get("cut_edges", [])) >= limits.review_cut_edges:
         review.append(f"cut by {len(record['cut_edges'])} photo edges")
+    review += neighbour_reasons(record, limits)
     if failed:
         return "failed", failed + review
     return ("review", review) if review else ("ok", [])
@@ -200,6 +206,18 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
          "the reconstruction's colour is off the photo's ({:.0f})"),
     )
     return [words.format(record[key]) for key, bad, words in checks if record.get(key) is not None and bad(record[key])]
+
+
+def neighbour_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> list[str]:
+    """Review reasons about neighbouring objects: one was cut away from the located object (the cut may run
+    through the vessel), or one was probably kept with it."""
+    reasons = []
+    if record.get("neighbour_cut"):
+        reasons.append("a neighbouring object was cut away from it: check the outline where they touched")
+    off = record.get("base_off_axis")
+    if off is not None and off > limits.review_base_off_axis:
+        reasons.append(f"another object probably merged into it ({off:.0%} of its lower part off the vessel's axis)")
+    return reasons
 
 
 def assess(prepared: Prepared, state: ObjectState, limits: QualityLimits = QualityLimits()) -> dict:

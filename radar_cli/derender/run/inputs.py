@@ -100,6 +100,9 @@ class Prepared:
             white); `photo_image` before `backdrop` replaced it.
         cut_edges: the photo edges the located object runs into (`top`, `bottom`, `left`, `right`).
         frame_coverage: share of the photo the located object covers; None if not located.
+        neighbour_cut: whether a neighbouring object merged into the located one was cut away from it.
+        base_off_axis: share of the located object's lowest rows off its symmetric core (a neighbour kept
+            with it where large); None if not located.
     """
 
     image: np.ndarray
@@ -113,6 +116,8 @@ class Prepared:
     cut_edges: tuple[str, ...] = ()
     frame_coverage: float | None = None
     photo_scene: np.ndarray | None = None
+    neighbour_cut: bool = False
+    base_off_axis: float | None = None
 
     def __post_init__(self) -> None:
         if self.photo_image is None:  # frozen: the network's crop is the output crop
@@ -342,7 +347,8 @@ def located_input(photo: np.ndarray, size: int, name: str, backdrop: Backdrop = 
                        photo_image=resize_image(found.image, side),
                        photo_silhouette=resize_mask(found.silhouette, side),
                        appendages=resize_mask(found.appendages, side), cut_edges=found.cut_edges,
-                       frame_coverage=round(found.frame_coverage, 4))
+                       frame_coverage=round(found.frame_coverage, 4), neighbour_cut=found.neighbour_removed,
+                       base_off_axis=round(found.base_off_axis, 4))
     return _on_backdrop(located, backdrop)
 
 

@@ -1,0 +1,85 @@
+"""Which parts of the border show the backdrop: a vignette or sweep however steep is all backdrop, an object
+running into the frame is not, a label standing in the band does not cut the backdrop beyond it off, and a flat
+frame round the picture is found. The pictures are drawn here."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from radar_cli.masks.border import backdrop_band, border_band, frame_padding
+from radar_cli.masks.neighbours import base_off_axis
+
+H, W = 300, 240
+
+
+def vignette(dark: float = 0.35) -> np.ndarray:
+    """H x W x 3 float: a studio backdrop lit from the lower right, falling off to `dark` at the upper left."""
+    y, x = np.mgrid[0:H, 0:W]
+    light = 1.0 - (1.0 - dark) * np.clip(((W - x) / W) ** 2 + ((H - y) / H) ** 2, 0, 1)
+    return np.repeat((0.85 * light)[..., None], 3, axis=2)
+
+
+def to_uint8(image: np.ndarray, seed: int = 0) -> np.ndarray:
+    noise = np.random.default_rng(seed).normal(0, 0.004, image.shape)
+    return (np.clip(image + noise, 0, 1) * 255 + 0.5).astype(np.uint8)
+
+
+def ellipse(cx: float, cy: float, rx: float, ry: float) -> np.ndarray:
+    y, x = np.mgrid[0:H, 0:W]
+    return ((x - cx) / rx) ** 2 + ((y - cy) / ry) ** 2 <= 1
+
+
+def test_a_steep_vignette_is_all_backdrop() -> None:
+    image = vignette()
+    image[ellipse(120, 150, 60, 90)] = [0.55, 0.3, 0.2]  # a vessel with a margin all round
+    photo = to_uint8(image)
+    assert int(photo[..., 0].max()) - int(photo[..., 0].min()) > 120  # the backdrop alone spans that much
+    assert (backdrop_band(photo) == border_band(photo.shape[:2])).all()
+
+
+def test_an_object_running_into_the_frame_is_left_out() -> None:
+    image = vignette(0.7)
+    vessel = ellipse(120, 250, 70, 110)  # cut by the bottom edge
+    image[vessel] = [0.2, 0.15, 0.12]
+    photo = to_uint8(image)
+    band, kept = border_band(photo.shape[:2]), backdrop_band(photo)
+    assert kept[band & vessel].mean() < 0.05  # (its slanting flanks cross the band's pixel rows unevenly)
+    assert kept[band & ~vessel].mean() > 0.97  # the rest of the band is kept
+
+
+def test_a_label_in_the_band_does_not_cut_off_the_floor_beyond_it() -> None:
+    image = vignette(0.3)[:, ::-1]  # lit from above: the floor is even, the walls are not
+    image[:] = image[:, W // 2 : W // 2 + 1]
+    image[ellipse(120, 140, 55, 80)] = [0.55, 0.3, 0.2]
+    label = np.zeros((H, W), bool)
+    label[275:, 150:200] = True  # a white card standing on the bottom edge
+    image[label] = 1.0
+    chart = np.zeros((H, W), bool)
+    chart[280:, 10:60] = True  # a colour chart in the other corner
+    image[chart] = [0.1, 0.6, 0.2]
+    photo = to_uint8(image)
+    kept = backdrop_band(photo)
+    floor = border_band(photo.shape[:2]) & ~label & ~chart
+    band = border_band(photo.shape[:2])
+    assert kept[band & (label | chart)].mean() < 0.05
+    assert kept[floor].mean() > 0.95
+
+
+def test_a_flat_frame_round_the_picture_is_found_and_a_plain_backdrop_is_not() -> None:
+    image = vignette()
+    image[ellipse(120, 150, 60, 90)] = [0.55, 0.3, 0.2]
+    framed = np.zeros_like(image)
+    framed[6:-6, 6:-6] = image[6:-6, 6:-6]
+    pad = frame_padding(to_uint8(framed))
+    assert pad[:6].all() and pad[:, :6].all() and pad[-6:].all() and pad[:, -6:].all()
+    assert not pad[20:-20, 20:-20].any()
+    plain = np.full((H, W, 3), 0.5)
+    plain[ellipse(120, 150, 60, 90)] = [0.55, 0.3, 0.2]
+    assert not frame_padding(to_uint8(plain)).any()
+
+
+def test_a_neighbour_kept_beside_the_base_is_off_the_axis() -> None:
+    vessel = ellipse(100, 150, 50, 100)
+    assert base_off_axis(vessel, vessel) == 0.0
+    neighbour = ellipse(170, 190, 40, 60)  # standing behind, overlapping its flank
+    assert base_off_axis(vessel | neighbour, vessel) > 0.1
