@@ -19,7 +19,8 @@ BAND = 6  # the full-resolution cut decides only this many pixels either side of
 
 # Hand-tuned seeds, per photo: (sure backdrop rectangles, sure object rectangles) as fractions of the photo
 # (x0, y0, x1, y1). Only where the automatic cut was wrong on the overlay.
-SEEDS: dict[str, tuple[tuple[tuple[float, float, float, float], ...], tuple[tuple[float, float, float, float], ...]]] = {}
+Box = tuple[float, float, float, float]
+SEEDS: dict[str, tuple[tuple[Box, ...], tuple[Box, ...]]] = {}
 
 
 def _border_model(image: np.ndarray, width: int) -> tuple[np.ndarray, float]:
@@ -81,8 +82,9 @@ def reference(photo: np.ndarray, name: str) -> np.ndarray:
     k = COARSE_SIDE / max(h, w)
     small = cv2.resize(photo, (round(w * k), round(h * k)), interpolation=cv2.INTER_AREA)
     coarse = cv2.resize(_coarse(small, name).astype(np.uint8), (w, h), interpolation=cv2.INTER_LINEAR) > 0
-    x0, y0 = max(0, np.nonzero(coarse.any(0))[0].min() - 4 * BAND), max(0, np.nonzero(coarse.any(1))[0].min() - 4 * BAND)
-    x1, y1 = min(w, np.nonzero(coarse.any(0))[0].max() + 4 * BAND), min(h, np.nonzero(coarse.any(1))[0].max() + 4 * BAND)
+    cols, rows = np.nonzero(coarse.any(0))[0], np.nonzero(coarse.any(1))[0]
+    x0, y0 = max(0, cols.min() - 4 * BAND), max(0, rows.min() - 4 * BAND)
+    x1, y1 = min(w, cols.max() + 4 * BAND), min(h, rows.max() + 4 * BAND)
     part = coarse[y0:y1, x0:x1].astype(np.uint8)
     disk = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * BAND + 1, 2 * BAND + 1))
     tri = np.full(part.shape, cv2.GC_BGD, np.uint8)

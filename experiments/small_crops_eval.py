@@ -79,7 +79,8 @@ def table(rows: list[dict]) -> str:
     kinds = list(dict.fromkeys(r["kind"] for r in rows))
     for kind in [*kinds, "all"]:
         s = np.array([r["iou"] for r in rows if kind in ("all", r["kind"])])
-        lines.append(f"| {kind} | {len(s)} | {s.mean():.3f} | {s.min():.3f} | {int((s >= PASS_IOU).sum())} of {len(s)} |")
+        passed = int((s >= PASS_IOU).sum())
+        lines.append(f"| {kind} | {len(s)} | {s.mean():.3f} | {s.min():.3f} | {passed} of {len(s)} |")
     return "\n".join(lines)
 
 

@@ -13,9 +13,15 @@ import numpy as np
 from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
 from radar_cli.masks.appendages import Core, find_axis, symmetric_core, upright_rotation
-from radar_cli.masks.neighbours import base_off_axis, split_neighbour
 from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fit_backdrop
-from radar_cli.masks.pipeline import Refined, Settings, check_photo, refine_detection, refine_window
+from radar_cli.masks.neighbours import base_off_axis, split_neighbour
+from radar_cli.masks.pipeline import (
+    Refined,
+    Settings,
+    check_photo,
+    refine_detection,
+    refine_window,
+)
 from radar_cli.masks.refine import main_component
 
 CUTOUT_MIN_CLEAR = 0.01  # an alpha channel with at least this share of clear pixels is a cut-out's silhouette
