@@ -205,37 +205,62 @@ def backdrop_band(image: np.ndarray) -> np.ndarray:
     return out.reshape(h, w)
 
 
-def _padded_lines(lines: np.ndarray) -> int:
-    """How many of the first L x N x 3 `lines` (outermost first) are a frame of one flat colour (mostly: an
-    object may run across it) that the line inside them breaks from."""
-    colour = np.median(lines[0], axis=0)
+def _padded_lines(lines: np.ndarray, colour: np.ndarray, share: float) -> int:
+    """How many of the first L x N x 3 `lines` (outermost first) are a frame of the flat `colour` (on at least
+    `share` of each line: an object may stand on it) that the line inside them breaks from."""
     flat = np.linalg.norm(lines - colour, axis=2) < PAD_SPREAD  # L x N
     count = 0
-    while count < len(lines) - 1 and flat[count].mean() >= PAD_SHARE:
+    while count < len(lines) - 1 and flat[count].mean() >= share:
         count += 1
     if count == 0 or np.median(np.linalg.norm(lines[count] - colour, axis=1)) < PAD_STEP:
         return 0  # no frame, or a plain backdrop that just goes on
     return count
 
 
+def _frame(image: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, int]]:
+    """Per side (top, bottom, left, right): its outermost lines (L x N x 3 float, outermost first), the frame's
+    colour and how many of the lines are frame (0: none)."""
+    h, w = image.shape[:2]
+    depth = max(1, round(PAD_MAX * max(h, w))) + 1
+    sides = [image[:depth], image[::-1][:depth], image[:, :depth].transpose(1, 0, 2),
+             image[:, ::-1][:, :depth].transpose(1, 0, 2)]
+    sides = [lines.astype(np.float32) for lines in sides]
+    own = [np.median(lines[0], axis=0) for lines in sides]
+    counts = [_padded_lines(lines, colour, PAD_SHARE) for lines, colour in zip(sides, own)]
+    framed = [colour for colour, count in zip(own, counts) if count]
+    out = []
+    for lines, colour, count in zip(sides, own, counts):
+        if framed and not count:  # the frame's colour from the other sides, on half the share of the line
+            colour = framed[0]
+            count = _padded_lines(lines, colour, PAD_SHARE / 2)
+        out.append((lines, colour, count))
+    return out
+
+
+def frame_inset(image: np.ndarray) -> tuple[int, int, int, int]:
+    """(top, bottom, left, right): how many rows and columns a flat frame round the picture (a black or white
+    border that squared it up) takes on each side, its edge smeared by resampling included; zeros without one.
+
+    Args:
+        image: H x W x 3 uint8 RGB.
+    """
+    counts = [count + PAD_SMEAR if count else 0 for _, _, count in _frame(image)]
+    return counts[0], counts[1], counts[2], counts[3]
+
+
 def frame_padding(image: np.ndarray) -> np.ndarray:
-    """H x W bool: a flat frame round the picture (a black or white border that squared it up), which is
-    neither backdrop nor object; only its flat pixels (an object crossing it keeps its own).
+    """H x W bool: the pixels of a flat frame round the picture (`frame_inset`), which is neither backdrop nor
+    object; only its flat pixels (an object crossing it keeps its own). A side mostly covered by an object (a
+    stand on the bottom edge) is found from the colour the other sides show.
 
     Args:
         image: H x W x 3 uint8 RGB.
     """
     h, w = image.shape[:2]
-    depth = max(1, round(PAD_MAX * max(h, w))) + 1
-    pixels = image.astype(np.float32)
     out = np.zeros((h, w), bool)
-    sides = [(pixels[:depth], out[:depth]), (pixels[::-1][:depth], out[::-1][:depth]),
-             (pixels[:, :depth].transpose(1, 0, 2), out[:, :depth].T),
-             (pixels[:, ::-1][:, :depth].transpose(1, 0, 2), out[:, ::-1][:, :depth].T)]
-    for lines, view in sides:
-        count = _padded_lines(lines)
+    views = [out, out[::-1], out.T, out[:, ::-1].T]
+    for view, (lines, colour, count) in zip(views, _frame(image)):
         if count:
-            colour = np.median(lines[0], axis=0)
-            view[:count] = np.linalg.norm(lines[:count] - colour, axis=2) < PAD_SPREAD
+            view[:count] |= np.linalg.norm(lines[:count] - colour, axis=2) < PAD_SPREAD
             view[count : count + PAD_SMEAR] |= view[count - 1]  # the frame's edge, smeared by resampling
     return out

@@ -20,6 +20,7 @@ import cv2
 import numpy as np
 
 from radar_cli.masks.border import backdrop_band, frame_padding
+from radar_cli.masks.outline import outline_support
 
 WORK_SIDE = 320  # detection runs at this long edge; refinement happens later at crop resolution
 MIN_AREA_FRAC = 0.01  # components smaller than this fraction of the image are noise (labels, dust)
@@ -131,7 +132,7 @@ def harmonic_fill(values: np.ndarray, known: np.ndarray, grid: int = 40, iterati
     return out.reshape(h, w, -1)
 
 
-def backdrop_distance(image: np.ndarray, band: np.ndarray) -> np.ndarray:
+def backdrop_distance(image: np.ndarray, band: np.ndarray, shading: bool = True) -> np.ndarray:
     """H x W distance of each pixel from the fitted backdrop, in units of the border noise.
 
     Shadows and light pools on the backdrop scale its colour by a common factor and carry no texture: where the
@@ -141,6 +142,8 @@ def backdrop_distance(image: np.ndarray, band: np.ndarray) -> np.ndarray:
     Args:
         image: H x W x 3 uint8 RGB (detection scale).
         band: H x W bool border band.
+        shading: forgive shading so; without, every brightness change counts (a greyscale photo of a vessel a
+            little darker than its backdrop, which would pass for its shadow).
     """
     smooth = cv2.GaussianBlur(image, (0, 0), 1.2).astype(np.float32)
     model, noise = fit_backdrop(smooth, band)
@@ -151,7 +154,7 @@ def backdrop_distance(image: np.ndarray, band: np.ndarray) -> np.ndarray:
     # band-pass detail: object outlines and surface texture have it, soft shadow edges and light pools do not
     texture = cv2.GaussianBlur(np.abs(grey - cv2.GaussianBlur(grey, (0, 0), 1.5)), (0, 0), 2.0) / noise.mean()
     lighting = (ratio > LIGHT_RANGE[0]) & (ratio < LIGHT_RANGE[1])
-    if np.quantile(np.ptp(smooth, axis=2), 0.98) < GREY_SPREAD:  # greyscale: brightness is all there is
+    if not shading:
         return dist
     return np.where(lighting, np.minimum(dist, 1.5 * chroma + 3.0 * texture), dist)
 
@@ -177,7 +180,12 @@ def saliency_map(image: np.ndarray) -> np.ndarray:
     return smap / max(float(smap.max()), 1e-6)
 
 
-def foreground_evidence(image: np.ndarray, band: np.ndarray | None = None) -> np.ndarray:
+def is_greyscale(image: np.ndarray) -> bool:
+    """Whether an H x W x 3 uint8 photo's channels differ by less than GREY_SPREAD almost everywhere."""
+    return bool(np.quantile(np.ptp(cv2.GaussianBlur(image, (0, 0), 1.2), axis=2), 0.98) < GREY_SPREAD)
+
+
+def foreground_evidence(image: np.ndarray, band: np.ndarray | None = None, shading: bool = True) -> np.ndarray:
     """H x W evidence in [0, 1] that a pixel is not backdrop: colour distance, plus edges and saliency near the
     threshold (they can lift a low-contrast pixel over it, never create an object alone).
 
@@ -185,9 +193,10 @@ def foreground_evidence(image: np.ndarray, band: np.ndarray | None = None) -> np
         image: H x W x 3 uint8 RGB.
         band: H x W bool, the pixels the backdrop is modelled from (default: the border pixels that show
             backdrop, `backdrop_band`).
+        shading: forgive the backdrop's shading (`backdrop_distance`).
     """
     band = backdrop_band(image) if band is None else band
-    dist = backdrop_distance(image, band)
+    dist = backdrop_distance(image, band, shading)
     colour = 1.0 - np.exp(-((dist / 6.0) ** 2))  # ~0.63 at 6 sigma
     extra = 0.25 * edge_map(image).clip(0, 1) + 0.15 * saliency_map(image)
     return np.clip(colour + extra * (colour > 0.15), 0.0, 1.0)
@@ -316,6 +325,25 @@ def _groups(boxes: list[tuple[int, int, int, int]], gap: float) -> list[list[int
     return list(out.values())
 
 
+def _cut(small: np.ndarray, band: np.ndarray, padding: np.ndarray, threshold: float, thorough: bool,
+         shading: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(evidence, object pixels) of a detection-scale photo (see `detect`)."""
+    evidence = foreground_evidence(small, band, shading)
+    raw = coarse_grabcut(small, evidence, threshold, band) & ~padding
+    if thorough and raw.any():  # model the backdrop again from all round the object, not only the border
+        # (vignettes, light pools, a stand's surroundings), and cut again
+        clear = ~(cv2.dilate(_clean(raw).astype(np.uint8), _square(RING * max(raw.shape))) > 0)
+        if clear.mean() > RING:
+            evidence = foreground_evidence(small, (clear | band) & ~padding, shading)
+            raw = coarse_grabcut(small, evidence, threshold, band) & ~padding
+    return evidence, raw
+
+
+def _support(small: np.ndarray, mask: np.ndarray) -> float:
+    """Outline support (`masks.outline`) of a detection-scale object mask; -1 if it is under MIN_AREA_FRAC."""
+    return (outline_support(small, mask) or 0.0) if mask.mean() >= MIN_AREA_FRAC else -1.0
+
+
 def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) -> list[Detection]:
     """Find the objects in a studio photograph.
 
@@ -331,14 +359,12 @@ def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) ->
     small, scale = downscale(image)
     padding = frame_padding(small)  # a flat frame round the picture: it must not join the object to its edges
     band = backdrop_band(small) & ~padding
-    evidence = foreground_evidence(small, band)
-    raw = coarse_grabcut(small, evidence, threshold, band) & ~padding
-    if thorough and raw.any():  # model the backdrop again from all round the object, not only the border
-        # (vignettes, light pools, a stand's surroundings), and cut again
-        clear = ~(cv2.dilate(_clean(raw).astype(np.uint8), _square(RING * max(raw.shape))) > 0)
-        if clear.mean() > RING:
-            evidence = foreground_evidence(small, (clear | band) & ~padding)
-            raw = coarse_grabcut(small, evidence, threshold, band) & ~padding
+    # a greyscale photo is read twice, shading forgiven and not (a shadow, or a vessel a little darker than its
+    # backdrop?): the reading whose outline lies more on the photo's edges is kept (one that finds no object
+    # of MIN_AREA_FRAC does not count)
+    readings = [_cut(small, band, padding, threshold, thorough, shading) for shading in
+                ((True, False) if is_greyscale(small) else (True,))]
+    evidence, raw = max(readings, key=lambda r: _support(small, _clean(r[1])))
     mask = _clean(raw)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     if n <= 1:

@@ -13,6 +13,7 @@ import numpy as np
 from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
 from radar_cli.masks.appendages import Core, find_axis, symmetric_core, upright_rotation
+from radar_cli.masks.border import frame_inset
 from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fit_backdrop
 from radar_cli.masks.neighbours import base_off_axis, split_neighbour
 from radar_cli.masks.pipeline import (
@@ -213,6 +214,8 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     """
     rgb, opaque = split_alpha(photo)
     check_photo(rgb, name)
+    top, bottom, left, right = (0, 0, 0, 0) if opaque is not None else frame_inset(rgb)
+    rgb = rgb[top : rgb.shape[0] - bottom, left : rgb.shape[1] - right]  # a flat frame round it is no part
     settings = Settings(size=size, margin=margin)
     if opaque is not None:
         found = alpha_detection(opaque)
@@ -231,5 +234,6 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     region = crops.valid_region(final, rgb.shape, size)
     k = refined.window.side / mask.shape[0]
     coverage = float(mask.sum() * k * k / (rgb.shape[0] * rgb.shape[1]))
-    return Located(image, core, whole & ~core, final, crops.cut_edges(whole, region), min(1.0, coverage),
+    box = crops.CropBox(final.x0 + left, final.y0 + top, final.side)  # in the photo with its frame
+    return Located(image, core, whole & ~core, box, crops.cut_edges(whole, region), min(1.0, coverage),
                    split.symmetry, stand, neighbour, base_off_axis(mask, split.core))

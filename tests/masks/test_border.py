@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from radar_cli.masks.border import backdrop_band, border_band, frame_padding
+from radar_cli.masks.border import PAD_SMEAR, backdrop_band, border_band, frame_inset, frame_padding
 from radar_cli.masks.neighbours import base_off_axis
 
 H, W = 300, 240
@@ -73,9 +73,13 @@ def test_a_flat_frame_round_the_picture_is_found_and_a_plain_backdrop_is_not() -
     pad = frame_padding(to_uint8(framed))
     assert pad[:6].all() and pad[:, :6].all() and pad[-6:].all() and pad[:, -6:].all()
     assert not pad[20:-20, 20:-20].any()
+    assert frame_inset(to_uint8(framed)) == (6 + PAD_SMEAR,) * 4
+    stood = framed.copy()
+    stood[-20:, 40:200] = [0.6, 0.45, 0.3]  # a plinth over most of the bottom edge: found from the other sides
+    assert frame_inset(to_uint8(stood))[1] == 6 + PAD_SMEAR
     plain = np.full((H, W, 3), 0.5)
     plain[ellipse(120, 150, 60, 90)] = [0.55, 0.3, 0.2]
-    assert not frame_padding(to_uint8(plain)).any()
+    assert not frame_padding(to_uint8(plain)).any() and frame_inset(to_uint8(plain)) == (0, 0, 0, 0)
 
 
 def test_a_neighbour_kept_beside_the_base_is_off_the_axis() -> None:

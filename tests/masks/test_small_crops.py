@@ -102,3 +102,23 @@ def test_a_greyscale_catalogue_plate_cut_at_top_and_bottom() -> None:
     grey = 0.5 + (grey - grey.mean()) * 0.5  # low contrast
     photo = to_photo(np.repeat(grey, 3, axis=2), quality=30)
     assert located_iou(photo, truth) >= 0.9
+
+
+def greyscale_with_shadow() -> tuple[np.ndarray, np.ndarray]:
+    """A greyscale photo of the vessel on a light grey backdrop with a soft shadow cast beside it: (photo,
+    truth)."""
+    image, mask = vessel(180, np.random.default_rng(5))
+    h, w = mask.shape
+    canvas = sweep(h + 40, w + 140, 0.8)
+    yy, xx = np.mgrid[0 : h + 40, 0 : w + 140]
+    shadow = np.exp(-(((xx - (w + 40)) / 45.0) ** 2 + ((yy - (h - 20)) / 60.0) ** 2))
+    canvas *= (1.0 - 0.18 * shadow)[..., None]  # a soft pool of shade: 0.82 of the backdrop at its middle
+    truth = np.zeros(canvas.shape[:2], bool)
+    place(canvas, truth, image, mask, 20, 20)
+    grey = canvas.mean(axis=2, keepdims=True)
+    return to_photo(np.repeat(grey, 3, axis=2)), truth
+
+
+def test_a_soft_shadow_beside_a_vessel_in_a_greyscale_photo_is_left_out() -> None:
+    photo, truth = greyscale_with_shadow()
+    assert located_iou(photo, truth) >= 0.9
