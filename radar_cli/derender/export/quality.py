@@ -113,7 +113,9 @@ def scores(prepared: Prepared, rendered: np.ndarray, recon: np.ndarray, mouth: n
     return {**fit_scores(prepared.photo_image, prepared.photo_silhouette, prepared.appendages, rendered, recon, mouth),
             "outline_support": _round(support(prepared)),
             "cut_edges": list(prepared.cut_edges),
-            "frame_coverage": _round(prepared.frame_coverage)}
+            "frame_coverage": _round(prepared.frame_coverage),
+            "neighbour_cut": prepared.neighbour_cut,
+            "base_off_axis": _round(prepared.base_off_axis)}
 
 
 def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None, rendered: np.ndarray,
@@ -144,8 +146,6 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
         "appendage_fraction": (None if app is None or whole is None or not whole.any()
                                else _round(float(app.sum()) / whole.sum())),
         "silhouette_area": None if sil is None else _round(float(sil.mean())),
-        "neighbour_cut": prepared.neighbour_cut,
-        "base_off_axis": _round(prepared.base_off_axis),
     }
 
 
