@@ -64,6 +64,11 @@ class Decomposition:
         """The same components on another device."""
         return self.map(lambda t: t.to(device))
 
+    @staticmethod
+    def concat(parts: "list[Decomposition]") -> "Decomposition":
+        """The batches `parts` one after the other (B = the sum of theirs)."""
+        return Decomposition(**{f.name: torch.cat([getattr(p, f.name) for p in parts]) for f in fields(Decomposition)})
+
     def select(self, index: int) -> "Decomposition":
         """Object `index` of the batch, as a batch of one."""
         return self.map(lambda t: t[index : index + 1])

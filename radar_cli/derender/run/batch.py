@@ -1,9 +1,9 @@
 """The `radar derender` driver: inputs -> crops -> network in batches -> per-object exports -> report.
 
 One bad input costs one line and one failures.csv row; the rest are processed. Finished object folders are
-skipped (a killed run resumes) and never overwritten without `overwrite`. Batches are cut from the whole input
-list before finished objects are dropped, so an object is always predicted beside the same neighbours (its files
-are the same bytes whether the run was resumed or split into shares, see radar_cli.derender.run.shard).
+skipped (a killed run resumes) and never overwritten without `overwrite`. An object's files are the same bytes
+whatever the batch size, worker count or share and wherever a killed run resumed: the network sees one photo at a
+time (Predictor.predict) and each object is refined and exported on one torch thread (EXPORT_THREADS).
 """
 
 from __future__ import annotations
@@ -208,13 +208,11 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
 def _run_batch(chunk: list[InputItem], todo: set[str], predictor: Predictor, options: DerenderOptions,
                envs: dict[str, np.ndarray], summary: BatchSummary, say: Callable[[str], None],
                sizes: SizeFinder) -> None:
-    """Crop and predict one whole batch and export its objects named in `todo`; failures are recorded item by
-    item (a finished object is predicted again only so that its neighbours see the same batch)."""
+    """Crop, predict and export the objects of a batch named in `todo`; failures are recorded item by item."""
+    chunk = [item for item in chunk if item.name in todo]
     prepared = _prepare_all(chunk, predictor.setup.image_size, options)
     ok = []
     for item, prep in zip(chunk, prepared):
-        if item.name not in todo and isinstance(prep, Failure):
-            continue
         if isinstance(prep, Failure):
             summary.failures.append(prep)
             say(prep.line())
@@ -224,7 +222,7 @@ def _run_batch(chunk: list[InputItem], todo: set[str], predictor: Predictor, opt
         return
     dec = predictor.predict([prep.image for _, prep in ok], [prep.silhouette for _, prep in ok])
     with torch_threads(EXPORT_THREADS):
-        _export_all(ok, todo, dec, predictor, options, envs, summary, say, sizes)
+        _export_all(ok, dec, predictor, options, envs, summary, say, sizes)
 
 
 def _run_views(item: InputItem, predictor: Predictor, options: DerenderOptions, envs: dict[str, np.ndarray],
@@ -244,13 +242,13 @@ def _run_views(item: InputItem, predictor: Predictor, options: DerenderOptions, 
     summary.done.append(item.name)
 
 
-def _export_all(ok: list[tuple[InputItem, Prepared]], todo: set[str], dec: Decomposition, predictor: Predictor,
+def _export_all(ok: list[tuple[InputItem, Prepared]], dec: Decomposition, predictor: Predictor,
                 options: DerenderOptions, envs: dict[str, np.ndarray], summary: BatchSummary,
                 say: Callable[[str], None], sizes: SizeFinder) -> None:
-    """Export each predicted object named in `todo`, options.workers at a time (threads: PNG and zlib encoding
+    """Export each predicted object, options.workers at a time (threads: PNG and zlib encoding
     and torch's operations release the GIL, and each object writes its own folder); an error costs that object
     only. Sizes are looked up here, in the calling thread (it holds the catalogs' connections)."""
-    ks = [k for k, (item, _) in enumerate(ok) if item.name in todo]
+    ks = list(range(len(ok)))
     found = {k: sizes.find(ok[k][0]) for k in ks}
 
     def one(k: int) -> Failure | None:

@@ -147,7 +147,11 @@ class Predictor:
     @torch.no_grad()
     def predict(self, images: Sequence[np.ndarray],
                 silhouettes: Sequence[np.ndarray | None] | None = None) -> Decomposition:
-        """De-render a batch of crops.
+        """De-render a batch of crops, each on its own.
+
+        The network runs on one image at a time: a convolution's sums are taken in another order for another
+        batch size, so a batched prediction would depend on the photos beside it (its batch size, worker count,
+        shard, or where a killed run resumed); one at a time, a photo always gives the same numbers.
 
         Args:
             images: S x S x 3 uint8 RGB crops, S = setup.image_size.
@@ -162,17 +166,27 @@ class Predictor:
         for im in images:
             if im.shape != (size, size, 3) or im.dtype != np.uint8:
                 raise InputError(f"expected {size} x {size} x 3 uint8 crops, got {im.shape} {im.dtype}")
-        coverage = None if silhouettes is None else _coverage(silhouettes, size).to(self.device)  # checks them
-        batch = torch.from_numpy(np.stack(images)).permute(0, 3, 1, 2)  # B x 3 x S x S uint8
-        batch = batch.to(self.device, torch.float32) / 255.0
+        masks: list[np.ndarray | None] = [None] * len(images) if silhouettes is None else list(silhouettes)
+        if len(masks) != len(images):
+            raise InputError(f"expected {len(images)} silhouettes, got {len(masks)}")
+        coverage = None if silhouettes is None else _coverage(masks, size)  # checks them all before any work
+        return Decomposition.concat([self._predict_one(im, mask, None if coverage is None else coverage[k : k + 1])
+                                     for k, (im, mask) in enumerate(zip(images, masks))])
+
+    def _predict_one(self, image: np.ndarray, silhouette: np.ndarray | None,
+                     coverage: torch.Tensor | None) -> Decomposition:
+        """One S x S x 3 uint8 crop (its 1 x 1 x S x S coverage, or None) de-rendered: a batch of one, on the
+        CPU."""
+        batch = torch.from_numpy(image).permute(2, 0, 1)[None].to(self.device, torch.float32) / 255.0
         dec = self.model(batch)
-        if self.pitch == "search" and silhouettes is not None:
-            dec = self._search_pitch(batch, silhouettes, dec)
+        if self.pitch == "search" and silhouette is not None:
+            assert isinstance(self.model, RadarModel)  # __init__ refuses the search without one
+            dec = search_pitch(self.model, batch, [silhouette], dec)
         if self.albedo == "divided":
             render, camera = self.setup.render, self.setup.camera
             shading = shade(dec.solid, dec.material, render, camera)
             albedo = divide_shading(batch, dec.solid, dec.albedo, dec.rho, shading, render,
-                                    camera, coverage)
+                                    camera, None if coverage is None else coverage.to(self.device))
             dec = dataclasses.replace(dec, albedo=albedo)
         return dec.detach().to("cpu")
 
@@ -196,18 +210,6 @@ class Predictor:
         refined, report = refine_object(self.model, batch, dec.to(self.device), crop, silhouette,
                                         self.setup.camera, light=light, reader=self.reader)
         return (dec if refined is None else refined.to("cpu")), report
-
-    def _search_pitch(self, batch: torch.Tensor, silhouettes: Sequence[np.ndarray | None],
-                      dec: Decomposition) -> Decomposition:
-        """`dec` with the searched pitch (and f_L, f_A re-read there) for the crops whose silhouette is known."""
-        known = [i for i, m in enumerate(silhouettes) if m is not None]
-        if not known:
-            return dec
-        index = torch.tensor(known, device=self.device)
-        part = dec.map(lambda t: t.index_select(0, index))
-        assert isinstance(self.model, RadarModel)  # __init__ refuses the search without one
-        found = search_pitch(self.model, batch.index_select(0, index), [m for m in silhouettes if m is not None], part)
-        return dec.combine(found, lambda t, f: t.index_copy(0, index, f))
 
 
 def _coverage(silhouettes: Sequence[np.ndarray | None], size: int) -> torch.Tensor:

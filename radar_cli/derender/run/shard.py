@@ -1,8 +1,8 @@
 """Splitting one `radar derender` collection over processes and machines: which inputs a share owns and the
 per-share failure lists (run/launch.py drives the shares).
 
-A share owns whole batches of the single-process run (batch k goes to share k mod N), so every object is
-predicted beside the same neighbours as without sharding and its files are the same bytes. Shares meet only
+A share owns whole batches of the single-process run (batch k goes to share k mod N); each object's files are
+the same bytes as without sharding (every photo is predicted on its own, see run/batch.py). Shares meet only
 through the results folder (a filesystem all machines see), so `--shard K/N` needs no network between jobs.
 """
 
