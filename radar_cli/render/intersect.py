@@ -16,6 +16,10 @@ from dataclasses import dataclass
 import torch
 
 BIG = 1e6  # a parameter far beyond any object (object-space units)
+SEARCH_CHUNK = 32768
+"""Rays searched at a time: a 512 px view's 262k rays cross ~8M (ray, segment) pairs, whose ~15 working tensors
+took 500 MB at once; chunks of 32k rays take ~60 MB. Every ray's search is its own (elementwise operations and
+per-ray minima), so the result is the same bits in chunks or at once."""
 
 
 @dataclass(frozen=True)
@@ -96,6 +100,19 @@ def _first(values: torch.Tensor, ray_idx: torch.Tensor, m: int) -> torch.Tensor:
 def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_idx: torch.Tensor,
            h: torch.Tensor, s_near: torch.Tensor, s_far: torch.Tensor, deep: float = float("inf"),
            misses: bool = True) -> Found:
+    """Exact first hits, mouth exits and minimisers of F = max(rho - r(y), |y| - h) along M rays, SEARCH_CHUNK
+    rays at a time (see _search for the arguments)."""
+    m = origin.shape[0]
+    if m <= SEARCH_CHUNK:
+        return _search(origin, direction, rows, b_idx, h, s_near, s_far, deep, misses)
+    parts = [_search(*(x[i : i + SEARCH_CHUNK] for x in (origin, direction)), rows,
+                     *(x[i : i + SEARCH_CHUNK] for x in (b_idx, h, s_near, s_far)), deep, misses)
+             for i in range(0, m, SEARCH_CHUNK)]
+    return Found(*(torch.cat([getattr(f, name) for f in parts]) for name in ("s_min", "s_hit", "hit", "inner", "cap")))
+
+
+def _search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_idx: torch.Tensor,
+            h: torch.Tensor, s_near: torch.Tensor, s_far: torch.Tensor, deep: float, misses: bool) -> Found:
     """Exact first hits, mouth exits and minimisers of F = max(rho - r(y), |y| - h) along M rays.
 
     Args:

@@ -252,6 +252,10 @@ def _extreme(values: torch.Tensor, reduce, fill: float) -> torch.Tensor:
     return torch.where(found.any(dim=1), out, torch.full_like(out, math.nan))
 
 
+OUTLINE_CHUNK = 8
+"""Solids outlined at a time: the refinement's 51 candidate pitches at 256 px held ~350 MB of float64 working
+tensors at once. Each solid's outline is its own, so the result is the same in chunks."""
+
 SWAP_XY = torch.tensor([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]], dtype=torch.float64)
 
 
@@ -266,6 +270,11 @@ def outline(solid: Solid, size: int,
     Returns:
         Outline in pixel-centre coordinates (float64).
     """
+    batch = solid.radius.shape[0]
+    if batch > OUTLINE_CHUNK:
+        parts = [outline(solid.map(lambda t: t[i : i + OUTLINE_CHUNK]), size, camera, n_discs)
+                 for i in range(0, batch, OUTLINE_CHUNK)]
+        return Outline(*(torch.cat([getattr(o, name) for o in parts]) for name in ("left", "right", "top", "bottom")))
     q = disc_conics(solid, n_discs or n_discs_for(size), camera)  # B x K x 3 x 3
     first, step = 1.0 / size - 1.0, 2.0 / size  # pixel centres, normalised
     left, right = _row_ends(q, (-first, -step, size))  # rows: normalised y = -c (up)

@@ -177,7 +177,7 @@ class Predictor:
                      coverage: torch.Tensor | None) -> Decomposition:
         """One S x S x 3 uint8 crop (its 1 x 1 x S x S coverage, or None) de-rendered: a batch of one, on the
         CPU."""
-        batch = torch.from_numpy(image).permute(2, 0, 1)[None].to(self.device, torch.float32) / 255.0
+        batch = torch.from_numpy(np.array(image)).permute(2, 0, 1)[None].to(self.device, torch.float32) / 255.0
         dec = self.model(batch)
         if self.pitch == "search" and silhouette is not None:
             assert isinstance(self.model, RadarModel)  # __init__ refuses the search without one
