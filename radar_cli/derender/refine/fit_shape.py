@@ -153,13 +153,18 @@ def _tan(camera: CameraConfig) -> float:
 
 
 def axis_from_outline(target: Outline, size: int, camera: CameraConfig) -> tuple[float, float]:
-    """(roll deg, tx) of the line through the rows' midpoints (least squares)."""
+    """(roll deg, tx) of the line through the rows' midpoints (least squares, summed exactly: LAPACK's solver gave
+    answers a few ulp apart for the same outline from one call to the next, and so other bytes for the same
+    photo)."""
     rows = torch.nonzero(~target.left[0].isnan()).flatten()
     if len(rows) < 2:
         raise ValueError("the silhouette covers fewer than two rows")
-    mid = ((target.left[0] + target.right[0]) / 2)[rows]
-    a = torch.stack([rows.double(), torch.ones(len(rows), dtype=torch.float64)], 1)
-    slope, intercept = torch.linalg.lstsq(a, mid[:, None]).solution[:, 0].tolist()
+    xs = rows.double().tolist()
+    ys = ((target.left[0] + target.right[0]) / 2)[rows].tolist()
+    mean_x, mean_y = math.fsum(xs) / len(xs), math.fsum(ys) / len(ys)
+    slope = (math.fsum((x - mean_x) * (y - mean_y) for x, y in zip(xs, ys))
+             / math.fsum((x - mean_x) ** 2 for x in xs))
+    intercept = mean_y - slope * mean_x
     centre_x = slope * (size / 2 - 0.5) + intercept
     tx = ((centre_x + 0.5) * 2 / size - 1) * _tan(camera) * camera.distance / camera.r_max
     return math.degrees(math.atan(slope)), tx
