@@ -111,7 +111,8 @@ def test_killed_at_random_points_and_resumed_gives_the_same_bytes(tmp_path: Path
     assert kills >= 2, "the run finished before it could be killed twice"
     done = subprocess.run(_command(tmp_path / "in", out), env=_env(), capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr[-3000:]
-    assert summary_objects(out) == summary_objects(reference) == [f"vase_{k:02d}" for k in range(2 * N_INPUTS)]
+    assert summary_objects(out) == summary_objects(reference)  # listed by quality status, then name
+    assert sorted(summary_objects(out)) == [f"vase_{k:02d}" for k in range(2 * N_INPUTS)]
     expected = object_files(reference)
     assert [name for name, data in object_files(out).items() if expected.get(name) != data] == []
     assert object_files(out).keys() == expected.keys()
