@@ -105,9 +105,11 @@ def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_
     m = origin.shape[0]
     if m <= SEARCH_CHUNK:
         return _search(origin, direction, rows, b_idx, h, s_near, s_far, deep, misses)
-    parts = [_search(*(x[i : i + SEARCH_CHUNK] for x in (origin, direction)), rows,
-                     *(x[i : i + SEARCH_CHUNK] for x in (b_idx, h, s_near, s_far)), deep, misses)
-             for i in range(0, m, SEARCH_CHUNK)]
+    parts = []
+    for i in range(0, m, SEARCH_CHUNK):
+        part = slice(i, i + SEARCH_CHUNK)
+        parts.append(_search(origin[part], direction[part], rows, b_idx[part], h[part], s_near[part], s_far[part],
+                             deep, misses))
     return Found(*(torch.cat([getattr(f, name) for f in parts]) for name in ("s_min", "s_hit", "hit", "inner", "cap")))
 
 

@@ -272,7 +272,7 @@ def outline(solid: Solid, size: int,
     """
     batch = solid.radius.shape[0]
     if batch > OUTLINE_CHUNK:
-        parts = [outline(solid.map(lambda t: t[i : i + OUTLINE_CHUNK]), size, camera, n_discs)
+        parts = [outline(solid.rows(i, i + OUTLINE_CHUNK), size, camera, n_discs)
                  for i in range(0, batch, OUTLINE_CHUNK)]
         return Outline(*(torch.cat([getattr(o, name) for o in parts]) for name in ("left", "right", "top", "bottom")))
     q = disc_conics(solid, n_discs or n_discs_for(size), camera)  # B x K x 3 x 3

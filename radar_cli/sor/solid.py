@@ -32,6 +32,10 @@ class Solid:
     def batch(self) -> int:
         return self.radius.shape[0]
 
+    def rows(self, start: int, stop: int) -> "Solid":
+        """Solids start..stop-1 of the batch."""
+        return Solid(self.radius[start:stop], self.height[start:stop], self.pose[start:stop])
+
     def map(self, fn: Callable[[torch.Tensor], torch.Tensor]) -> "Solid":
         """The same solids with `fn` applied to each tensor (detach, to a device, select rows...)."""
         return Solid(fn(self.radius), fn(self.height), fn(self.pose))

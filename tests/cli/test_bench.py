@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+import pytest
 from click.testing import CliRunner
 
 from radar_cli.cli import cli
@@ -27,6 +28,7 @@ def test_bench_render_rejects_bad_sizes():
     assert result.exit_code == 2 and "--sizes" in result.output
 
 
+@pytest.mark.slow
 def test_bench_masks_and_derender_print_json():
     result = CliRunner().invoke(cli, ["bench", "masks", "--photos", "1", "--long-side", "400", "--size", "64",
                                       "--workers", "1"])
@@ -41,6 +43,7 @@ def test_bench_masks_and_derender_print_json():
     assert report["resolution"] == [96] and report["export_seconds_per_object"] > 0 and report["peak_rss_mib"] > 0
 
 
+@pytest.mark.slow
 def test_bench_masks_with_worker_processes_finishes():
     # worker processes started after the parent used OpenCV and torch once deadlocked (forked thread pools)
     import subprocess

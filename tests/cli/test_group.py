@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import click
+import pytest
 from click.testing import CliRunner
 
 from radar_cli import __version__
@@ -64,6 +65,7 @@ def test_every_visible_option_has_help_text():
     assert not missing, missing
 
 
+@pytest.mark.slow
 def test_bench_train_runs_outside_the_checkout(tmp_path):
     """Its default preset comes from the installed package, not a path relative to the repository."""
     env = dict(os.environ, PYTHONPATH=str(REPO), OMP_NUM_THREADS="1")

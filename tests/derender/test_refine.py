@@ -74,6 +74,7 @@ def test_no_silhouette_keeps_the_network():
     assert kept is None and report.status == "fallback" and "silhouette" in report.reason
 
 
+@pytest.mark.slow
 def test_lighting_fit_runs_after_the_shape_and_repeats_bit_for_bit():
     """--refine full: the environment map is fitted (or the network's kept, and said so); the same object gives the
     same tensors again, on one thread or two (the export workers run it on any)."""

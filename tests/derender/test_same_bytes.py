@@ -95,7 +95,7 @@ def test_killed_at_random_points_and_resumed_gives_the_same_bytes(tmp_path: Path
     assert done.returncode == 0, done.stderr[-3000:]
     out, rng, kills = tmp_path / "out", random.Random(34), 0
     finished = lambda: len(list(out.glob("*/material.json")))  # noqa: E731
-    for attempt in range(3):  # killed after a random number of finished objects and a random extra wait
+    for _attempt in range(3):  # killed after a random number of finished objects and a random extra wait
         target, extra = finished() + rng.randint(1, 2), rng.uniform(0.0, 0.3)
         run = subprocess.Popen(_command(tmp_path / "in", out), env=_env(), stdout=subprocess.DEVNULL,
                                stderr=subprocess.DEVNULL, start_new_session=True)

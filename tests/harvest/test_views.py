@@ -156,6 +156,7 @@ def test_bad_views_are_skipped_or_failed_and_retried_and_the_object_kept(server,
     assert files(out / "met") == ["7.json", "7/7_0.jpg", "7/7_4.jpg"]
 
 
+@pytest.mark.slow
 def test_cli_images_all_exit_codes(server, tmp_path):
     server.add(7, views=1)
     ids = tmp_path / "ids.txt"

@@ -75,7 +75,7 @@ def write_meshes(folder: Path, state: ObjectState, n_cols: int, height_cm: float
     obj_mesh.visual.material = trimesh.visual.material.SimpleMaterial(  # type: ignore[union-attr]
         name="albedo", image=material.baseColorTexture, diffuse=(255, 255, 255, 255),
         ambient=(255, 255, 255, 255), specular=(spec, spec, spec, 255), glossiness=float(state.material.alpha[0]))
-    obj_mesh.visual.material.image.encoderinfo = dict(TEXTURE_PNG)
+    obj_mesh.visual.material.image.encoderinfo = dict(TEXTURE_PNG)  # type: ignore[union-attr]
     text, files = trimesh.exchange.obj.export_obj(obj_mesh, include_texture=True, return_texture=True,
                                                   mtl_name="mesh.mtl")
     for name, data in files.items():
