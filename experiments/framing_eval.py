@@ -164,7 +164,7 @@ def judge_status(results: Results, items: list[tuple[str, Variant]], batch: int 
     silhouettes (`BROKEN`) are added and judged as well."""
 
     predictor = Predictor.from_checkpoint(device="cpu")
-    size = predictor.setup.image_size
+    size = predictor.setup.render.image_size
     spoilt = add_spoilt(results, items, size)
     for start in range(0, len(items), batch):
         chunk = list(range(start, min(start + batch, len(items))))

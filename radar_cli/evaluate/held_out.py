@@ -105,7 +105,7 @@ def evaluate_object(item, predictor: Predictor, resolution: Resolution, say: Cal
                     config: MultiviewConfig = MultiviewConfig()) -> tuple[list[HeldOut], np.ndarray | None]:
     """Every side view of one multi-view object left out in turn: (rows, the picture) or ([], None) with fewer
     than MIN_SIDE_VIEWS side views."""
-    views, _ = read_views(item, predictor.setup.image_size, "auto", "white", resolution, say)
+    views, _ = read_views(item, predictor.setup.render.image_size, "auto", "white", resolution, say)
     readable = [v for v in views if v.prepared is not None]
     dec = predictor.predict([v.crops.image for v in readable], [v.crops.silhouette for v in readable])
     own_fits(views, [dec.select(k) for k in range(len(readable))], config, predictor.setup.camera)

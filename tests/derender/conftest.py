@@ -11,14 +11,15 @@ import torch
 import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig
-from radar_cli.derender.run.predictor import ModelSetup, Predictor
+from radar_cli.derender.run.predictor import Predictor
+from radar_cli.model.config import ModelConfig
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.lighting import GAMMA
 
 SIZE = 64
-SETUP = ModelSetup(RenderConfig(image_size=SIZE, tex_height=32, tex_width=32, env_height=8, env_width=24,
-                                shading_height=16, shading_width=16),
-                   CameraConfig(), GeometryConfig(n_rows=16, n_cols=24))
+SETUP = ModelConfig(render=RenderConfig(image_size=SIZE, tex_height=32, tex_width=32, env_height=8, env_width=24,
+                                        shading_height=16, shading_width=16),
+                    camera=CameraConfig(), geometry=GeometryConfig(n_rows=16, n_cols=24))
 
 
 class FakeModel:

@@ -14,7 +14,8 @@ from PIL import Image
 from radar_cli.config import CameraConfig, GeometryConfig
 from radar_cli.derender.export.object_folder import ExportConfig
 from radar_cli.derender.run.batch import DerenderOptions, derender
-from radar_cli.derender.run.predictor import ModelSetup, Predictor
+from radar_cli.derender.run.predictor import Predictor
+from radar_cli.model.config import ModelConfig
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.texture import front_third
 
@@ -46,7 +47,7 @@ def _derender_truth(tmp_path: Path, albedo: str) -> list[Path]:
     cfg = synth.SynthConfig(size=64, seed=3)
     synth.generate(tmp_path / "data", {"test": 2}, cfg, workers=1, progress=False)
     samples = sorted((tmp_path / "data" / "test").iterdir())
-    setup = ModelSetup(cfg.render_config(), CameraConfig(), GeometryConfig())
+    setup = ModelConfig(render=cfg.render_config(), camera=CameraConfig(), geometry=GeometryConfig())
     predictor = Predictor(GroundTruth(samples), setup, "ground-truth", "cpu", albedo)  # type: ignore[arg-type]
     summary = derender([tmp_path / "data"], predictor, DerenderOptions(out=tmp_path / "out",
                                                                         export=ExportConfig(0, 32)))

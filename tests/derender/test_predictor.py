@@ -48,7 +48,7 @@ def save_weights(path: Path, config, weights_config=None) -> Path:
 def test_tiny_model_predicts(tmp_path: Path) -> None:
     path = save_weights(tmp_path / "tiny.safetensors", tiny_config())
     predictor = Predictor.from_checkpoint(path, "cpu")
-    assert predictor.setup.image_size == 32 and predictor.version.startswith("tiny.safetensors#")
+    assert predictor.setup.render.image_size == 32 and predictor.version.startswith("tiny.safetensors#")
     dec = predictor.predict([np.full((32, 32, 3), 128, np.uint8)] * 2)
     assert dec.radius.shape == (2, 16) and dec.albedo.shape == (2, 3, 16, 16) and dec.env.shape == (2, 4, 12)
     assert not dec.radius.requires_grad

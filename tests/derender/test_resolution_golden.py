@@ -120,7 +120,7 @@ def run_network_size(root: Path, **resolution) -> dict[str, str | dict]:
 
 
 def test_network_side_reproduces_the_network_outputs(tmp_path: Path) -> None:
-    found = run_network_size(tmp_path, resolution=SETUP.image_size)
+    found = run_network_size(tmp_path, resolution=SETUP.render.image_size)
     extra = {name for name in found if name.split("/")[1] in SHADING_RENDERS}
     if os.environ.get("RADAR_WRITE_GOLDEN"):
         pinned = {name: digest for name, digest in found.items() if name not in extra}

@@ -70,7 +70,7 @@ def test_bundled_model_predicts_the_same_on_cuda():
     rng = np.random.default_rng(0)
     cpu = Predictor.from_checkpoint(None, "cpu")
     gpu = Predictor.from_checkpoint(None, "cuda")
-    size = cpu.setup.image_size
+    size = cpu.setup.render.image_size
     images = [rng.integers(0, 256, (size, size, 3), dtype=np.uint8) for _ in range(3)]
     a, b = cpu.predict(images), gpu.predict(images)
     for x, y in zip(a.tensors(), b.tensors()):

@@ -13,9 +13,10 @@ from radar_cli.derender.export.mesh import write_meshes
 from radar_cli.derender.export.quality import assess_drawn
 from radar_cli.derender.export.renders import write_renders
 from radar_cli.derender.run.inputs import InputItem, Prepared
-from radar_cli.derender.run.predictor import AlbedoSource, ModelSetup, PitchSource
+from radar_cli.derender.run.predictor import AlbedoSource, PitchSource
 from radar_cli.derender.run.state import ObjectState
 from radar_cli.fileio import write_json
+from radar_cli.model.config import ModelConfig
 from radar_cli.results import APPENDAGES_FILE, INPUT_FILE, MATERIAL_FILE, SILHOUETTE_FILE
 from radar_cli.sizes import ObjectSize
 
@@ -42,7 +43,7 @@ def is_complete(folder: Path) -> bool:
     return (folder / MATERIAL_FILE).is_file()
 
 
-def export_object(folder: Path, item: InputItem, prepared: Prepared, state: ObjectState, setup: ModelSetup,
+def export_object(folder: Path, item: InputItem, prepared: Prepared, state: ObjectState, setup: ModelConfig,
                   version: str, envs: dict[str, np.ndarray], config: ExportConfig = ExportConfig(),
                   albedo_source: AlbedoSource = "network", pitch_source: PitchSource = "network",
                   refine: dict | None = None, size: ObjectSize | None = None, extra: dict | None = None) -> dict:
@@ -84,7 +85,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         "crop_box": prepared.crop.to_list(),
         "photo_size": list(prepared.photo_size),
         "backdrop": prepared.backdrop,
-        "image_size": setup.image_size,
+        "image_size": setup.render.image_size,
         "resolution": side,
         "view_size": config.view_side(side),
         "model": version,

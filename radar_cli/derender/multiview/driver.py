@@ -69,7 +69,7 @@ def fit_views(item: InputItem, predictor: Predictor, crop: CropMode, backdrop: B
               say: Callable[[str], None], config: MultiviewConfig = MultiviewConfig()) -> tuple[ObjectFit,
                                                                                                list[Failure]]:
     """Read, predict and fit one multi-view object (its Failures: the photos left out unread)."""
-    views, failures = read_views(item, predictor.setup.image_size, crop, backdrop, resolution, say)
+    views, failures = read_views(item, predictor.setup.render.image_size, crop, backdrop, resolution, say)
     readable = [v.crops for v in views if v.prepared is not None]
     dec = predictor.predict([p.image for p in readable], [p.silhouette for p in readable])
     decs = [dec.select(k) for k in range(len(readable))]

@@ -210,7 +210,7 @@ def _run_batch(chunk: list[InputItem], todo: set[str], predictor: Predictor, opt
                sizes: SizeFinder) -> None:
     """Crop, predict and export the objects of a batch named in `todo`; failures are recorded item by item."""
     chunk = [item for item in chunk if item.name in todo]
-    prepared = _prepare_all(chunk, predictor.setup.image_size, options)
+    prepared = _prepare_all(chunk, predictor.setup.render.image_size, options)
     ok = []
     for item, prep in zip(chunk, prepared):
         if isinstance(prep, Failure):

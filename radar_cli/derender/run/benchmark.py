@@ -85,7 +85,7 @@ def _export_cost(predictor: Predictor, photo_dir: Path, out: Path, resolution: R
     time on EXPORT_THREADS torch threads (as radar derender exports), and the memory it took."""
     setup = predictor.setup
     items = [InputItem(p.stem, p) for p in sorted(photo_dir.glob("*.png"))]
-    prepared = [prepare(item, setup.image_size, resolution=resolution) for item in items]
+    prepared = [prepare(item, setup.render.image_size, resolution=resolution) for item in items]
     dec = predictor.predict([p.image for p in prepared], [p.silhouette for p in prepared])
     envs = environments((), setup.render.env_height, setup.render.env_width)
     refine_s, refine_cpu_s, state_s, write_s, cpu_s = [], [], [], [], []
@@ -155,7 +155,7 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         over the objects.
     """
     predictor = predictor or Predictor.from_checkpoint(checkpoint, device, albedo, pitch, refine)
-    size = predictor.setup.image_size
+    size = predictor.setup.render.image_size
     images = _photos(n_images, size)
     with torch_threads(threads):
         net_wall, net_cpu = _network_rate(predictor, images, batch_size)

@@ -5,18 +5,18 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Literal, Sequence
 
 import numpy as np
 import torch
 
-from radar_cli.config import CameraConfig, GeometryConfig, RenderConfig
+from radar_cli.config import CameraConfig
 from radar_cli.derender.refine.driver import REFINE_MODES, RefineMode, RefineReport, refine_object
 from radar_cli.derender.refine.fit_light import LightFitConfig
 from radar_cli.derender.refine.pitch_search import search_pitch
 from radar_cli.errors import CheckpointError, InputError
+from radar_cli.model.config import ModelConfig
 from radar_cli.model.outputs import Decomposition
 from radar_cli.model.radar import RadarModel
 from radar_cli.model.specular_reader import SpecularReader
@@ -70,19 +70,6 @@ def resolve_device(name: str) -> torch.device:
     return device
 
 
-@dataclass(frozen=True)
-class ModelSetup:
-    """The parts of a model's configuration that de-rendering and export need."""
-
-    render: RenderConfig
-    camera: CameraConfig
-    geometry: GeometryConfig
-
-    @property
-    def image_size(self) -> int:
-        return self.render.image_size
-
-
 class Predictor:
     """Batches images through a de-rendering model on one device.
 
@@ -102,7 +89,7 @@ class Predictor:
         reader: reads the specular albedo at the refined shape (model.specular_reader; None: f_L's re-reading).
     """
 
-    def __init__(self, model: Callable[[torch.Tensor], Decomposition], setup: ModelSetup, version: str,
+    def __init__(self, model: Callable[[torch.Tensor], Decomposition], setup: ModelConfig, version: str,
                  device: torch.device | str = "cpu", albedo: AlbedoSource = "divided",
                  pitch: PitchSource = "network", refine: RefineMode = "none", reader: SpecularReader | None = None):
         if albedo not in ALBEDO_SOURCES:
@@ -136,13 +123,12 @@ class Predictor:
         model, _ = load_model(path, dev)
         model.eval()
         cfg = model.config
-        setup = ModelSetup(cfg.render, cfg.camera, cfg.geometry)
         specular = None if refine == "none" else load_reader(reader, cfg.camera, dev)
         version = f"{path.name}#{_short_hash(path)}"
         if specular is not None:
             read_from = reader_path(reader)
             version += f" + {read_from.name}#{_short_hash(read_from)}"
-        return cls(model, setup, version, dev, albedo, pitch, refine, specular)
+        return cls(model, cfg, version, dev, albedo, pitch, refine, specular)
 
     @torch.no_grad()
     def predict(self, images: Sequence[np.ndarray],
@@ -154,7 +140,7 @@ class Predictor:
         shard, or where a killed run resumed); one at a time, a photo always gives the same numbers.
 
         Args:
-            images: S x S x 3 uint8 RGB crops, S = setup.image_size.
+            images: S x S x 3 uint8 RGB crops, S = setup.render.image_size.
             silhouettes: per crop, its S x S bool object mask or None; the divided albedo keeps the network's
                 where the predicted surface unwraps from off the object, and the pitch search runs where it is
                 known.
@@ -162,7 +148,7 @@ class Predictor:
         Returns:
             Decomposition of the batch, on the CPU, detached.
         """
-        size = self.setup.image_size
+        size = self.setup.render.image_size
         for im in images:
             if im.shape != (size, size, 3) or im.dtype != np.uint8:
                 raise InputError(f"expected {size} x {size} x 3 uint8 crops, got {im.shape} {im.dtype}")
@@ -203,7 +189,7 @@ class Predictor:
         """
         if self.refine == "none":
             return dec, RefineReport("off", "--refine none", crop.shape[0])
-        if crop.shape[0] <= self.setup.image_size:
+        if crop.shape[0] <= self.setup.render.image_size:
             return dec, RefineReport("off", "the output is at the network's size", crop.shape[0])
         batch = torch.from_numpy(image).permute(2, 0, 1)[None].to(self.device, torch.float32) / 255.0
         light = LightFitConfig() if self.refine == "full" else None

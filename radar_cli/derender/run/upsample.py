@@ -10,8 +10,9 @@ import torch
 import torch.nn.functional as F
 
 from radar_cli.derender.run.inputs import Prepared
-from radar_cli.derender.run.predictor import AlbedoSource, ModelSetup
+from radar_cli.derender.run.predictor import AlbedoSource
 from radar_cli.derender.run.state import ObjectState
+from radar_cli.model.config import ModelConfig
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.material import Material
 from radar_cli.render.scene import divide_shading, shade
@@ -42,7 +43,7 @@ def photo_tensors(prepared: Prepared) -> tuple[torch.Tensor, torch.Tensor | None
 
 
 @torch.no_grad()
-def full_resolution_state(dec: Decomposition, prepared: Prepared, setup: ModelSetup,
+def full_resolution_state(dec: Decomposition, prepared: Prepared, setup: ModelConfig,
                           albedo_source: AlbedoSource) -> ObjectState:
     """The state exported at the output side N = prepared.side.
 
@@ -65,7 +66,7 @@ def full_resolution_state(dec: Decomposition, prepared: Prepared, setup: ModelSe
         ObjectState with albedo 1 x 3 x N x 3N (N x N frontal third) and radius 1 x max(128, L) when N != S.
     """
     side = prepared.side
-    if side == setup.image_size:
+    if side == setup.render.image_size:
         return ObjectState.from_decomposition(dec, setup.render, setup.camera)
     radius = smooth_rows(dec.radius.float(), max(PROFILE_ROWS, dec.radius.shape[1]))
     front = resize_front(dec.albedo.float().clamp(0, 1), side)  # 1 x 3 x N x N
