@@ -27,9 +27,9 @@ from tqdm import tqdm
 from radar_cli.errors import InputError, NetworkError
 from radar_cli.fileio import remove_stale_temps, write_bytes, write_text
 from radar_cli.harvest.catalog import CATALOG_NAME, Catalog, open_catalog
-from radar_cli.harvest.client import BodyTooLarge, ClientConfig, FetchError, HttpClient
+from radar_cli.harvest.client import ClientConfig, FetchError, HttpClient
 from radar_cli.harvest.dimensions import size_of_record
-from radar_cli.harvest.images import MAX_PIXELS, ImageRejected, store_image
+from radar_cli.harvest.images import MAX_PIXELS, download_image
 from radar_cli.harvest.met_api import DEFAULT_API_URL, MetApi
 from radar_cli.harvest.views import ViewStage, read_stored_record
 
@@ -257,37 +257,22 @@ class Harvester:
         row = self.catalog.get(object_id)
         assert row is not None and row["image_url"], object_id
         old = Path(self.config.out) / row["image_path"] if row["image_path"] else None
-        headers = {}
-        if row["etag"] and old is not None and old.is_file():
-            headers["If-None-Match"] = row["etag"]  # a --since refetch: keep the image if it did not change
-        try:
-            reply = self.images.get(row["image_url"], headers=headers)
-        except BodyTooLarge as e:
-            self.catalog.set_state(object_id, "skipped", "image_too_large")
-            tqdm.write(f"object {object_id}: skipped: {e}")
-            return
-        if reply.status == 304 and old is not None:
+        got = download_image(self.images, row["image_url"], row["etag"], old, self.folder, object_id,
+                             self.config.max_pixels)
+        if got.outcome == "unchanged":
             self.catalog.set_image(object_id, row["image_path"], row["bytes"], row["sha256"], row["etag"])
             self.summary.images_unchanged += 1
-            return
-        if reply.status in (404, 410):
-            self.catalog.set_state(object_id, "skipped", "image_missing")
-            return
-        if reply.status != 200:
-            self._fail(object_id, f"image HTTP {reply.status}")
-            return
-        try:
-            stored = store_image(reply.body, self.folder, object_id, self.config.max_pixels)
-        except ImageRejected as e:
-            if e.skip_reason:
-                self.catalog.set_state(object_id, "skipped", e.skip_reason)
-                tqdm.write(f"object {object_id}: skipped: {e}")
-            else:
-                self._fail(object_id, str(e))
-            return
-        rel = stored.path.relative_to(Path(self.config.out)).as_posix()
-        self.catalog.set_image(object_id, rel, stored.size, stored.sha256, reply.headers.get("ETag", ""))
-        self.summary.images_fetched += 1
+        elif got.outcome == "skipped":
+            self.catalog.set_state(object_id, "skipped", got.reason)
+            if got.message:
+                tqdm.write(f"object {object_id}: skipped: {got.message}")
+        elif got.outcome == "failed":
+            self._fail(object_id, got.reason)
+        else:
+            assert got.stored is not None
+            rel = got.stored.path.relative_to(Path(self.config.out)).as_posix()
+            self.catalog.set_image(object_id, rel, got.stored.size, got.stored.sha256, got.etag)
+            self.summary.images_fetched += 1
 
 
 def _write_failures(catalog: Catalog, out: Path) -> None:

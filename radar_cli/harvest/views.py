@@ -20,8 +20,8 @@ from tqdm import tqdm
 
 from radar_cli.errors import NetworkError
 from radar_cli.harvest.catalog import Catalog
-from radar_cli.harvest.client import BodyTooLarge, FetchError, HttpClient
-from radar_cli.harvest.images import ImageRejected, image_stem, store_image
+from radar_cli.harvest.client import FetchError, HttpClient
+from radar_cli.harvest.images import download_image, image_stem
 
 MAX_RECORD_BYTES = 16 * 1024 * 1024  # a stored object record (as the API sent it) larger than this is not read
 MAX_VIEWS = 100  # additional images kept per object at most
@@ -135,32 +135,22 @@ class ViewStage:
         """Fetch one view (conditional on its ETag when its file is there) and record the outcome."""
         object_id, index = view["object_id"], view["view"]
         old = self.out / view["image_path"] if view["image_path"] else None
-        headers = {"If-None-Match": view["etag"]} if view["etag"] and old is not None and old.is_file() else {}
-        try:
-            reply = self.client.get(view["url"], headers=headers)
-        except BodyTooLarge as e:
-            self.catalog.set_view(object_id, index, "skipped", "image_too_large")
-            tqdm.write(f"object {object_id} view {index}: skipped: {e}")
-            return
-        if reply.status == 304 and headers:
+        folder = object_folder(self.out, self.objects_dir, object_id)
+        got = download_image(self.client, view["url"], view["etag"], old, folder, object_id, self.max_pixels,
+                             view=index)
+        if got.outcome == "unchanged":
             self.catalog.set_view(object_id, index, "image", "", view["image_path"], view["bytes"], view["sha256"],
                                   view["etag"])
             self.totals.views_unchanged += 1
             return
-        if reply.status != 200:
-            missing = reply.status in (404, 410)
-            self.catalog.set_view(object_id, index, "skipped" if missing else "failed",
-                                  "image_missing" if missing else f"image HTTP {reply.status}")
+        if got.outcome != "stored":
+            self.catalog.set_view(object_id, index, got.outcome, got.reason)
+            if got.message:
+                tqdm.write(f"object {object_id} view {index}: {got.outcome}: {got.message}")
             return
-        folder = object_folder(self.out, self.objects_dir, object_id)
-        try:
-            stored = store_image(reply.body, folder, object_id, self.max_pixels, view=index)
-        except ImageRejected as e:
-            self.catalog.set_view(object_id, index, "skipped" if e.skip_reason else "failed", e.skip_reason or str(e))
-            tqdm.write(f"object {object_id} view {index}: {'skipped' if e.skip_reason else 'failed'}: {e}")
-            return
-        if old is not None and old != stored.path:
+        assert got.stored is not None
+        if old is not None and old != got.stored.path:
             old.unlink(missing_ok=True)  # the view changed format
-        self.catalog.set_view(object_id, index, "image", "", stored.path.relative_to(self.out).as_posix(),
-                              stored.size, stored.sha256, reply.headers.get("ETag", ""))
+        self.catalog.set_view(object_id, index, "image", "", got.stored.path.relative_to(self.out).as_posix(),
+                              got.stored.size, got.stored.sha256, got.etag)
         self.totals.views_fetched += 1
