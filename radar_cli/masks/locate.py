@@ -33,6 +33,7 @@ STAND_COLOUR_STEP = 30.0  # ... and whose mean colour is this far (RGB levels) f
 STAND_BIG_STEP = 0.25  # ... unless the width step is this large
 GAP_RING = (0.02, 0.06)  # the backdrop around the object is modelled from this ring (fraction of the window)
 GAP_DISTANCE = 3.0  # object pixels this close to the backdrop model (in its noise units) may be backdrop ...
+GAP_LEVELS = 20.0  # ... or this close in RGB levels, Euclidean (a gap seen through the vessel is lit otherwise) ...
 GAP_MIN = 0.002  # ... seen through the object where they form a patch of at least this share of it ...
 GAP_DEPTH = 0.08  # ... that comes this close (fraction of the object's width) to its outline ...
 
@@ -153,7 +154,7 @@ def remove_stand(mask: np.ndarray, image: np.ndarray) -> tuple[np.ndarray, bool]
     return main_component(mask & ~stand), True
 
 
-def open_gaps(mask: np.ndarray, image: np.ndarray) -> np.ndarray:
+def open_gaps(mask: np.ndarray, image: np.ndarray, outside: np.ndarray | None = None) -> np.ndarray:
     """Take out of a located object the backdrop seen between a handle and the body: patches of the object
     whose colour the backdrop around it explains, near its outline and beside the vessel's axis (a patch of
     the body's own decoration that matches the backdrop is rarely all three). The located mask has them filled
@@ -161,6 +162,7 @@ def open_gaps(mask: np.ndarray, image: np.ndarray) -> np.ndarray:
 
     Args:
         mask: n x n bool located object. image: n x n x 3 uint8, the pixels it was located in.
+        outside: n x n bool, the padding beyond the photo's edge (no backdrop to model there), if any.
 
     Returns:
         n x n bool mask without the gaps (its largest part).
@@ -172,11 +174,13 @@ def open_gaps(mask: np.ndarray, image: np.ndarray) -> np.ndarray:
     near = cv2.dilate(mask.astype(np.uint8), np.ones((3, 3), np.uint8), iterations=max(1, int(GAP_RING[0] * n)))
     far = cv2.dilate(mask.astype(np.uint8), np.ones((3, 3), np.uint8), iterations=max(2, int(GAP_RING[1] * n)))
     ring = (far > 0) & ~(near > 0)
+    if outside is not None:
+        ring &= ~outside
     if ring.sum() < 50:
         return mask
     pixels = image.astype(np.float32)
     model, noise = fit_backdrop(pixels, ring)
-    dist = np.sqrt((((pixels - model) / noise) ** 2).sum(axis=2))
+    dist = np.sqrt((((pixels - model) / np.maximum(noise, GAP_LEVELS / GAP_DISTANCE)) ** 2).sum(axis=2))
     candidate = (mask & (dist < GAP_DISTANCE)).astype(np.uint8)
     count, labels, stats, _ = cv2.connectedComponentsWithStats(candidate, connectivity=4)
     if count <= 1:
@@ -227,7 +231,7 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
         found = detections[0]
         refined = refine_detection(rgb, found, settings)
     mask, neighbour = split_neighbour(refined.mask)
-    mask, stand = remove_stand(open_gaps(mask, refined.image), refined.image)
+    mask, stand = remove_stand(open_gaps(mask, refined.image, refined.outside), refined.image)
     split: Core = symmetric_core(mask)
     final, image, core = refined.framed(rgb, split.core, settings, fill=255)  # beyond the frame: white
     _, _, whole = refined.framed(rgb, mask, settings, box_mask=split.core)

@@ -106,6 +106,12 @@ def test_backdrop_between_a_hugging_handle_and_the_body_is_opened() -> None:
     opened = open_gaps(mask, image)
     assert not (opened & ~mask).any() and opened[body].all()
     assert iou(symmetric_core(opened).core, body) >= 0.97
+    mask, image, _ = _hugging_handles(208)  # the backdrop seen through the gap, a little lighter: opened
+    assert iou(symmetric_core(open_gaps(mask, image)).core, body) >= 0.97
+    outside = np.zeros_like(mask)
+    outside[:, 185:] = True  # the window's padding beyond the photo's edge, another grey: not backdrop
+    image[outside] = 120
+    assert iou(symmetric_core(open_gaps(mask, image, outside)).core, body) >= 0.97
     mask, image, _ = _hugging_handles(120)  # no backdrop between them: nothing is opened
     assert (open_gaps(mask, image) == mask).all()
     decorated = image.copy()
