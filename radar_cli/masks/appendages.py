@@ -6,7 +6,10 @@ the core keeps the run of object pixels that holds the axis (the loop of a handl
 another run), clipped to the shorter of its two half-widths (a spout sticks out on one side only) and to the
 row's radius after a vertical opening of the radius profile (a handle's attachment widens a few rows on both
 sides; the body's own curve is smooth over that span). A narrow part standing on the rim (a volute or a
-handle's top seen face on, above the mouth) is an appendage too, though it reaches the top.
+handle's top seen face on, above the mouth) is an appendage too, though it reaches the top. So are handle
+plates: where a handle rises on each side, apart from the body, into the top rows (a column-krater seen from
+the front), those rows are bounded by the handles' outer edges just under them; the plates beyond are the
+handles' own.
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ MIN_APPENDAGE = 0.004  # appendage parts smaller than this fraction of the silho
 SPIKE_WIDTH = 0.6  # rows above the rim narrower than this fraction of the rim's radius stand on it (a handle)
 SPIKE_SPAN = 0.2  # ... where the rim is the widest row within this fraction of the height from the top
 SHELF = 0.25  # ... and the rim widens from them in one row by at least this fraction of its radius
+PLATE_BELOW = (0.02, 0.06)  # a handle's outer edge is read this far under its top (fractions of the height)
 
 
 @dataclass(frozen=True)
@@ -116,6 +120,63 @@ def _top_spike(radius: np.ndarray, limit: np.ndarray, rows: np.ndarray) -> np.nd
     return out
 
 
+def _outer_extents(mask: np.ndarray, axis: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per row, the distance from the axis to the outermost object pixel's far edge on the left and on the right
+    (NaN where that side has none)."""
+    h, w = mask.shape
+    xs = np.arange(w) + 0.5 - (axis + 0.5)
+    left = np.where(mask & (xs < 0), -xs + 0.5, -np.inf).max(1)
+    right = np.where(mask & (xs >= 0), xs + 0.5, -np.inf).max(1)
+    return np.where(np.isfinite(left), left, np.nan), np.where(np.isfinite(right), right, np.nan)
+
+
+def _runs_of(flags: np.ndarray, length: int) -> np.ndarray:
+    """`flags` (bool, n) kept only in runs of at least `length` consecutive True."""
+    padded = np.concatenate([[0], flags.astype(np.int8), [0]])
+    starts, ends = np.nonzero(np.diff(padded) == 1)[0], np.nonzero(np.diff(padded) == -1)[0]
+    out = np.zeros_like(flags, dtype=bool)
+    for a, b in zip(starts, ends):
+        out[a:b] = b - a >= length
+    return out
+
+
+def _handle_plates(mask: np.ndarray, axis: float, left: np.ndarray, right: np.ndarray, limit: np.ndarray,
+                   rows: np.ndarray) -> np.ndarray:
+    """`limit` bounded, over the top rows that a handle on each side rises into from below, by the mean of the
+    two handles' outer edges just under them (`PLATE_BELOW`): the plates the handles carry reach past the rim.
+
+    Args:
+        mask: H x W bool upright silhouette. axis: its axis' x. left, right: H, the axis runs' half-widths
+            (`_axis_runs`). limit: H, the per-row half-width bound. rows: the rows holding an axis run.
+    """
+    out = limit.copy()
+    height = rows.max() - rows.min() + 1
+    outer_l, outer_r = _outer_extents(mask, axis)
+    window = np.arange(rows.min(), min(mask.shape[0], rows.min() + int(round(SPIKE_SPAN * height))))
+    run = max(2, int(round(PLATE_BELOW[1] * height)))  # a handle: longer than a ragged or lopsided plate
+    kept_l, kept_r = np.fmin(left, limit), np.fmin(right, limit)  # what the core keeps on each side so far
+    apart = np.stack([_runs_of(outer_l[window] > kept_l[window] + 1.0, run),
+                      _runs_of(outer_r[window] > kept_r[window] + 1.0, run)])  # 2 x n: beside a handle
+    joined = np.nonzero(~apart.any(0))[0]  # neither: the plates, the rim
+    if len(joined) == 0:
+        return out
+    start = joined[0]  # a volute beside the core's first rows stands apart above them
+    below = [start + np.argmax(apart[s, start:]) if apart[s, start:].any() else -1 for s in (0, 1)]
+    if min(below) <= start:
+        return out
+    edges = []
+    for s, outer, kept in ((0, outer_l, kept_l), (1, outer_r, kept_r)):
+        a = window[below[s]] + int(round(PLATE_BELOW[0] * height))
+        b = window[below[s]] + max(1, int(round(PLATE_BELOW[1] * height)))
+        handle = outer[a:b][outer[a:b] > kept[a:b] + 1.0]
+        if len(handle) == 0:
+            return out
+        edges.append(float(np.median(handle)))
+    band = window[start : min(below)]
+    out[band] = np.fmin(out[band], float(np.mean(edges)))
+    return out
+
+
 def _opening(profile: np.ndarray, span: int) -> np.ndarray:
     """Grey opening of a 1-D profile (NaN = no object) with a window of `span` samples: peaks narrower than the
     window are cut down to their surroundings."""
@@ -151,6 +212,7 @@ def upright_core(mask: np.ndarray, axis: float) -> np.ndarray:
     opened = _opening(radius, int(round(BUMP_SPAN * (rows.max() - rows.min() + 1))))
     limit = np.fmin(radius, _keep_ends(radius, opened, tol, rows)) + tol
     limit = _top_spike(radius, limit, rows)
+    limit = _handle_plates(mask, axis, left, right, limit, rows)
     xs = np.arange(mask.shape[1]) + 0.5 - (axis + 0.5)  # pixel centres relative to the axis
     core = np.zeros_like(mask)
     for y in rows[limit[rows] > 0]:
