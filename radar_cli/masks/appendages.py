@@ -9,7 +9,8 @@ sides; the body's own curve is smooth over that span). A narrow part standing on
 handle's top seen face on, above the mouth) is an appendage too, though it reaches the top. So are handle
 plates: where a handle rises on each side, apart from the body, into the top rows (a column-krater seen from
 the front), those rows are bounded by the handles' outer edges just under them; the plates beyond are the
-handles' own.
+handles' own. Handles that go on above the rim on both sides (a volute-krater's) pass outside it: the top rows
+are bounded by their inner edges.
 """
 
 from __future__ import annotations
@@ -144,6 +145,7 @@ def _handle_plates(mask: np.ndarray, axis: float, left: np.ndarray, right: np.nd
                    rows: np.ndarray) -> np.ndarray:
     """`limit` bounded, over the top rows that a handle on each side rises into from below, by the mean of the
     two handles' outer edges just under them (`PLATE_BELOW`): the plates the handles carry reach past the rim.
+    Where the object stands above those rows on both sides (volutes), by the handles' inner edges instead.
 
     Args:
         mask: H x W bool upright silhouette. axis: its axis' x. left, right: H, the axis runs' half-widths
@@ -164,11 +166,20 @@ def _handle_plates(mask: np.ndarray, axis: float, left: np.ndarray, right: np.nd
     below = [start + np.argmax(apart[s, start:]) if apart[s, start:].any() else -1 for s in (0, 1)]
     if min(below) <= start:
         return out
+    xs = np.arange(mask.shape[1]) + 0.5 - (axis + 0.5)  # pixel centres relative to the axis
+    above = mask[: rows.min()]
+    volutes = min(int((above & (xs < 0)).any(1).sum()), int((above & (xs > 0)).any(1).sum())) >= END_ROWS * height
     edges = []
     for s, outer, kept in ((0, outer_l, kept_l), (1, outer_r, kept_r)):
         a = window[below[s]] + int(round(PLATE_BELOW[0] * height))
         b = window[below[s]] + max(1, int(round(PLATE_BELOW[1] * height)))
-        handle = outer[a:b][outer[a:b] > kept[a:b] + 1.0]
+        if volutes:  # the handle's first pixel past what the core keeps
+            side = np.abs(xs) * (np.sign(xs) == (1 if s else -1))
+            beyond = mask[a:b] & (side > kept[a:b, None] + 1.0)
+            handle = np.where(beyond, side, np.inf).min(1) - 0.5
+            handle = handle[np.isfinite(handle)]
+        else:
+            handle = outer[a:b][outer[a:b] > kept[a:b] + 1.0]
         if len(handle) == 0:
             return out
         edges.append(float(np.median(handle)))
