@@ -157,10 +157,12 @@ def _fit_light(refined: Decomposition, network_env: torch.Tensor, crop: np.ndarr
                camera: CameraConfig, config: LightFitConfig, report: RefineReport) -> tuple[Decomposition,
                                                                                              RefineReport]:
     """`refined` with its environment map fitted to the crop's shading (derender.refine.fit_light), starting from the
-    network's first reading `network_env` (1 x He x We), or with that map where too few texels are usable."""
+    network's first reading `network_env` (1 x He x We), and its specular albedo lowered to the highlights the fit
+    found; or with that map where too few texels are usable."""
     with torch.no_grad():
         fit = fit_environment(crop, silhouette, refined.radius, refined.height, refined.pose, network_env,
                               float(refined.alpha[0]), float(refined.rho[0]), camera, config)
     if fit is None:
         return dataclasses.replace(refined, env=network_env), dataclasses.replace(report, light="kept")
-    return dataclasses.replace(refined, env=fit.env), dataclasses.replace(report, light="fitted", light_rmse=fit.rmse)
+    return (dataclasses.replace(refined, env=fit.env, rho=refined.rho * fit.specular_scale),
+            dataclasses.replace(report, light="fitted", light_rmse=fit.rmse))

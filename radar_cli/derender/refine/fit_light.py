@@ -24,7 +24,7 @@ the same photograph (docs/refinement.md measures it).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
@@ -94,11 +94,15 @@ class LightFit:
         rmse: (fitted, start) root-mean-square error of the paints' model against the texture on the used
             texels, display levels 0..1.
         texels: texels used.
+        specular_scale: the factor (<= 1) on the specular albedo that keeps the highlights as bright as the
+            fits drew them, the map being brought to the starting map's mean (1 where the fits drew them
+            brighter: the specular albedo is never raised here).
     """
 
     env: torch.Tensor
     rmse: tuple[float, float]
     texels: int
+    specular_scale: float = 1.0
 
 
 def upsampler(coarse: tuple[int, int], size: tuple[int, int]) -> torch.Tensor:
@@ -242,13 +246,18 @@ def _fit(crop: np.ndarray, silhouette: np.ndarray, radius: torch.Tensor, height:
     free = _free_map(texels, start, config)
     transport = torch.cat([texels.kd, texels.ks]).T.float().contiguous()  # E x 2n
     problem = LobeProblem(transport, texels.linear, rho, (start.shape[0], start.shape[1]))
-    maps = []
+    maps, means = [], []
     for k in config.lobe_counts:
         lobes = fit_lobes(problem, free, k, texels.paints, config.lobe_rounds, config.lobe_steps,
                           config.lobe_tolerance, config.sharpness, config.start_sharpness,
                           math.radians(config.min_elevation))
-        maps.append(lobes / max(float(lobes.mean()), 1e-12))
+        means.append(max(float(lobes.mean()), 1e-12))
+        maps.append(lobes / means[-1])
     fitted = torch.stack(maps).mean(0).clamp_min(0.0) if maps else free.reshape(-1)
+    # the paints take up the diffuse light's scale, the highlights do not: the map's scale that the fits found
+    # is what the photo's highlights support (a photo without them: a dim map), and the specular albedo keeps it
+    scale = min(1.0, float(np.median(means)) / max(float(start.mean()), 1e-12)) if means else 1.0
     fitted = fitted * (float(start.mean()) / max(float(fitted.mean()), 1e-12))
-    rmse = (texels.rmse(fitted), texels.rmse(start.reshape(-1)))
-    return LightFit(fitted.reshape(1, *start.shape).to(env.dtype).to(env.device), rmse, int(texels.paint.numel()))
+    rmse = (replace(texels, rho=rho * scale).rmse(fitted), texels.rmse(start.reshape(-1)))
+    return LightFit(fitted.reshape(1, *start.shape).to(env.dtype).to(env.device), rmse, int(texels.paint.numel()),
+                    scale)
