@@ -12,6 +12,8 @@ from radar_cli.config import CameraConfig
 from radar_cli.derender.refine.fit_light import LightFitConfig, fit_environment, smoothness, upsampler
 from radar_cli.evaluate.metrics import env_error
 from radar_cli.synth.generator import SynthConfig, make_sample
+from radar_cli.synth.layout import ALBEDO_FILE
+from radar_cli.synth.render import render_sample
 
 SIZE = 256
 
@@ -68,3 +70,23 @@ def test_operators():
     assert torch.allclose(up.sum(1), torch.ones(768, dtype=torch.float64))  # a constant map stays constant
     smooth = smoothness(LightFitConfig().coarse)
     assert torch.allclose(smooth @ torch.ones(192, dtype=torch.float64), torch.zeros(192, dtype=torch.float64))
+
+
+@pytest.mark.parametrize("index", [0, 2])
+def test_a_matte_black_glaze_gets_no_invented_highlights(index):
+    """A vase in black glaze (its albedo x 0.15) photographed without highlights, fitted with a specular albedo of
+    0.5 held: the lobe fits find the light too dim for highlights, and the specular albedo is lowered to keep them
+    so (the map brought to the starting mean alone would draw highlights the photo does not have). The same vase
+    with highlights (specular albedo 0.5) keeps most of them."""
+    _, mask, shape, truth, params = _sample(index)
+    files, _ = make_sample(SynthConfig(size=SIZE, seed=3), "test", index, None)
+    scales = []
+    for rho in (0.0, 0.5):
+        photo = render_sample(np.asarray(params["radius"]), params["height"], tuple(params["pose"]),
+                              files[ALBEDO_FILE] * 0.15, truth, params["alpha"], rho, SIZE,
+                              SynthConfig(size=SIZE).render_config())
+        image = (np.clip(photo.image, 0, 1) * 255 + 0.5).astype(np.uint8)
+        fit = fit_environment(image, mask, *shape, _blurred(truth), params["alpha"], 0.5, CameraConfig())
+        assert fit is not None
+        scales.append(fit.specular_scale)
+    assert scales[0] <= 0.25 and scales[1] >= 0.5, scales
