@@ -106,13 +106,13 @@
             src: path(o.id, v.picture),
             loading: "lazy",
             alt: v.name,
-            width: kind === "mini" ? 40 : null,
-            height: kind === "mini" ? 40 : 128,
+            width: kind === "mini" ? 44 : null,
+            height: kind === "mini" ? 44 : 128,
           })
         : el("div", { class: "missing", text: "unreadable" });
       const caption =
         kind === "mini"
-          ? el("figcaption", { text: v.name + " " + viewTurn(v) })
+          ? el("figcaption", {}, el("div", { text: v.name }), el("div", { text: viewTurn(v) }))
           : el("figcaption", {}, el("b", { text: v.name }), el("br"), v.used ? viewTurn(v) + " · used" : "left out",
               v.used || !v.reason ? null : el("span", { class: "reason", text: ": " + v.reason }));
       strip.append(el("figure", { class: v.used ? "used" : "left-out", title: viewLabel(v) }, img, caption));
