@@ -48,6 +48,7 @@ MATERIAL_SPHERE_FILE = "material_sphere.png"
 TURNTABLE_GIF_FILE = "turntable.gif"
 TURNTABLE_STRIP_FILE = "turntable.png"
 COVERAGE_FILE = "coverage.png"  # objects with several views: which view gave each texel of albedo.png (black: none)
+VIEWS_DIR = "views"  # objects with several views: views/<photo>.png, its crop beside the object drawn as it sees it
 RELIT_PREFIX = "relit_"  # relit_<environment>.png
 
 # material.json keys that `radar eval` reads (others may be present)

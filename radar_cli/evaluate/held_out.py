@@ -16,7 +16,6 @@ from typing import Callable
 
 import cv2
 import numpy as np
-import torch
 
 from radar_cli.derender.export.maps import write_picture
 from radar_cli.derender.export.quality import psnr
@@ -25,15 +24,14 @@ from radar_cli.derender.multiview.fit import (
     MultiviewConfig,
     ViewFit,
     choose_side_views,
-    exported_solid,
     fit_chosen,
     own_fits,
 )
+from radar_cli.derender.multiview.pictures import draw_view
 from radar_cli.derender.run.inputs import Resolution, collect_inputs
 from radar_cli.derender.run.predictor import Predictor
-from radar_cli.derender.run.state import ObjectState
-from radar_cli.fileio import to_uint8, write_text
-from radar_cli.render.scene import render_view, rotate_full_map
+from radar_cli.fileio import write_text
+from radar_cli.render.scene import rotate_full_map
 from radar_cli.render.texture import front_third, full_from_front
 
 MIN_SIDE_VIEWS = 3
@@ -66,16 +64,6 @@ def masked_ssim(a: np.ndarray, b: np.ndarray, mask: np.ndarray, sigma: float = 1
     return float(ssim[mask].mean())
 
 
-def _draw(view: ViewFit, albedo: torch.Tensor, turn: float, predictor: Predictor) -> np.ndarray:
-    """The view drawn at its own shape, pose and lighting with an object-frame albedo, N x N x 3 uint8."""
-    a = view.looks
-    render = ObjectState.export_render(predictor.setup.render)
-    material = a.material.map(torch.Tensor.float).with_albedo(albedo)
-    with torch.no_grad():
-        image, _ = render_view(exported_solid(a), material, view.crops.side, -turn, render, predictor.setup.camera)
-    return to_uint8(image[0].permute(1, 2, 0).numpy())
-
-
 def _angle(a: float, b: float) -> float:
     return abs((a - b + 180) % 360 - 180)
 
@@ -94,7 +82,7 @@ def leave_out(views: list[ViewFit], held: ViewFit, full: dict[int, tuple], predi
     nearest = min(others, key=lambda v: _angle(v.turn, turn))
     single = rotate_full_map(full_from_front(front_third(nearest.tex.albedo)), nearest.turn)
     photo, mask = held.photo, held.mask
-    multi_image, single_image = (_draw(held, albedo, turn, predictor) for albedo in (fit.fused_map.albedo, single))
+    multi_image, single_image = (draw_view(held, albedo, turn, predictor) for albedo in (fit.fused_map.albedo, single))
     score = HeldOut("", Path(held.source).stem, round(turn % 360, 2), Path(nearest.source).stem,
                     psnr(multi_image[mask], photo[mask]), masked_ssim(multi_image, photo, mask),
                     psnr(single_image[mask], photo[mask]), masked_ssim(single_image, photo, mask))

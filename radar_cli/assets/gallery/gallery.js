@@ -5,6 +5,7 @@
 "use strict";
 (function () {
   const DATA = window.RADAR_GALLERY || { objects: [], builtin_envs: [], failed: 0, scores: [] };
+  for (const o of DATA.objects) o.views = o.views || []; // data.js written before objects had several views
   const PAGE_SIZE = 120;
   // objects of known size (meshes in metres) are all seen from this far, so their sizes compare on screen
   const REAL_SIZE_DISTANCE = "2m";
@@ -83,11 +84,40 @@
       img,
       el("div", { class: "id", text: o.id + " " }, badge(o.status)),
       title(o) ? el("div", { class: "title", text: title(o), title: title(o) }) : null,
+      o.views.length ? viewStrip(o, "mini") : null,
     );
     node.addEventListener("keydown", (e) => {
       if (e.key === "Enter") open();
     });
     return node;
+  }
+
+  // one photograph of an object seen from several sides: "front, 0°" or "top, left out: <why>"
+  const viewTurn = (v) => (v.used ? fmt(v.turn_deg, 0) + "°" : "left out");
+  const viewLabel = (v) => v.name + ", " + (v.used ? viewTurn(v) + ", used" : "left out" + (v.reason ? ": " + v.reason : ""));
+
+  function viewStrip(o, kind) {
+    // the card's strip shows each view's photograph (the left half of its picture); the detail view the whole
+    // picture (photograph | the object drawn as that view sees it) and why a view was left out
+    const strip = el("div", { class: "views " + kind, "aria-label": o.views.length + " views" });
+    for (const v of o.views) {
+      const img = v.picture
+        ? el("img", {
+            src: path(o.id, v.picture),
+            loading: "lazy",
+            alt: v.name,
+            width: kind === "mini" ? 44 : null,
+            height: kind === "mini" ? 44 : 128,
+          })
+        : el("div", { class: "missing", text: "unreadable" });
+      const caption =
+        kind === "mini"
+          ? el("figcaption", {}, el("div", { text: v.name }), el("div", { text: viewTurn(v) }))
+          : el("figcaption", {}, el("b", { text: v.name }), el("br"), v.used ? viewTurn(v) + " · used" : "left out",
+              v.used || !v.reason ? null : el("span", { class: "reason", text: ": " + v.reason }));
+      strip.append(el("figure", { class: v.used ? "used" : "left-out", title: viewLabel(v) }, img, caption));
+    }
+    return strip;
   }
 
   function renderOverview() {
@@ -343,14 +373,28 @@
       img.addEventListener("error", () => img.parentElement && img.parentElement.remove());
       box.append(el("figure", {}, img, el("figcaption", { text: label })));
     }
+    const fused = o.views.some((v) => v.used);
     box.append(
       el(
         "figure",
         {},
         el("img", { src: path(o.id, "albedo.png"), class: "wide", loading: "lazy", alt: "albedo 360" }),
-        el("figcaption", { text: "albedo, unwrapped 360° (the back mirrored from the front)" }),
+        el("figcaption", {
+          text: fused
+            ? "albedo, unwrapped 360°, fused from the used views (the 3D view and the turntable carry it)"
+            : "albedo, unwrapped 360° (the back mirrored from the front)",
+        }),
       ),
     );
+    if (o.coverage)
+      box.append(
+        el(
+          "figure",
+          {},
+          el("img", { src: path(o.id, "coverage.png"), class: "wide", loading: "lazy", alt: "coverage" }),
+          el("figcaption", { text: "which view gave each texel (in the views' order: red, green, blue, yellow; black: none)" }),
+        ),
+      );
     return box;
   }
 
@@ -372,6 +416,8 @@
       nav,
       el("h2", { text: o.id + " " }, badge(o.status)),
       el("div", { class: "cols" }, viewer(o), info(o)),
+      o.views.length ? el("h3", { text: `${o.views.length} photographs, ${o.views.filter((v) => v.used).length} used` }) : null,
+      o.views.length ? viewStrip(o, "full") : null,
       pictures(o),
     );
     document.title = "radar: " + o.id;

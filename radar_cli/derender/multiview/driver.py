@@ -1,7 +1,7 @@
 """`radar derender` for an object photographed from several sides (a sub-folder of photos, run.inputs): its views
 read and cropped (an unreadable photo is left out with one line, the object goes on with the others), the network
 run on them as one batch, the object fitted from all of them (multiview.fit) and exported from its first used view
-with the fused albedo, coverage.png and material.json's `views`."""
+with the fused albedo, coverage.png, a picture per view (views/) and material.json's `views`."""
 
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ import numpy as np
 from radar_cli.derender.export.maps import write_picture
 from radar_cli.derender.export.object_folder import ExportConfig, export_object
 from radar_cli.derender.multiview.fit import MultiviewConfig, ObjectFit, ViewFit, fit_object, object_state, views_record
+from radar_cli.derender.multiview.pictures import write_view_pictures
 from radar_cli.derender.run.inputs import (
     Backdrop,
     CropMode,
@@ -93,8 +94,9 @@ def derender_views(item: InputItem, predictor: Predictor, out: Path, crop: CropM
     folder = out / item.name
     folder.mkdir(parents=True, exist_ok=True)
     write_picture(folder / COVERAGE_FILE, fit.fused_map.coverage_image())
+    pictures = write_view_pictures(folder, fit, predictor)
     assert first.report is not None
     export_object(folder, InputItem(item.name, Path(first.source)), first.crops, object_state(fit, predictor),
                   predictor.setup, predictor.version, envs, export, "divided", predictor.pitch, first.report.record(),
-                  size=size, extra=views_record(fit))
+                  size=size, extra=views_record(fit, pictures))
     return failures

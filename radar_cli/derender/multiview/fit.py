@@ -115,9 +115,9 @@ class ViewFit:
         assert self.texture is not None, f"{self.source}: not unwrapped"
         return self.texture
 
-    def record(self, share: float) -> dict:
-        """material.json's entry for this view."""
-        entry = {"source": self.source, "used": self.used, "reason": self.reason}
+    def record(self, share: float, picture: str | None = None) -> dict:
+        """material.json's entry for this view (`picture`: its views/ file, relative to the object's folder)."""
+        entry = {"source": self.source, "used": self.used, "reason": self.reason, "picture": picture}
         if self.used and self.geometry is not None:
             pitch, roll, tx, ty = (round(float(v), 4) for v in self.geometry.pose[0])
             clean = lambda v: None if v != v else round(v, 4)  # noqa: E731
@@ -266,12 +266,15 @@ def object_state(fit: ObjectFit, predictor: Predictor) -> ObjectState:
     return dataclasses.replace(state, material=state.material.with_albedo(albedo))
 
 
-def views_record(fit: ObjectFit) -> dict:
-    """material.json's `views` (every photo: used or left out and why, turn, pose) and `coverage`."""
+def views_record(fit: ObjectFit, pictures: dict[int, str] | None = None) -> dict:
+    """material.json's `views` (every photo: used or left out and why, turn, pose, its picture from `pictures`,
+    by id(view)) and `seen_fraction`."""
     shares = {}
     if fit.fused is not None:
         total = fit.fused.share.sum(dim=0).sum()
         for view, share in zip(fit.used, fit.fused.share):
             shares[id(view)] = float(share.sum() / max(float(total), 1e-12))
     seen = None if fit.fused is None else round(fit.fused.seen_fraction(), 4)
-    return {"views": [v.record(shares.get(id(v), 0.0)) for v in fit.views], "seen_fraction": seen}
+    pictures = pictures or {}
+    return {"views": [v.record(shares.get(id(v), 0.0), pictures.get(id(v))) for v in fit.views],
+            "seen_fraction": seen}

@@ -13,6 +13,7 @@ from __future__ import annotations
 import base64
 import json
 import math
+import re
 import shutil
 import sqlite3
 from pathlib import Path
@@ -24,6 +25,7 @@ from radar_cli.errors import RadarError
 from radar_cli.fileio import atomic_path, read_image, write_image, write_text
 from radar_cli.results import (
     APPENDAGES_FILE,
+    COVERAGE_FILE,
     ENV_MAP_FILE,
     INDEX_FILE,
     INPUT_FILE,
@@ -31,6 +33,7 @@ from radar_cli.results import (
     RECON_FILE,
     RELIT_PREFIX,
     SUMMARY_FILE,
+    VIEWS_DIR,
 )
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets" / "gallery"
@@ -47,6 +50,7 @@ MAX_META_BYTES = 1024 * 1024  # meta.json beside an input is untrusted: refuse l
 STATUS_UNKNOWN = "unknown"  # objects without a quality record
 SCORE_KEYS = ("silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction", "outline_support",
               "frame_coverage")
+VIEW_PICTURE = re.compile(re.escape(VIEWS_DIR) + r"/[A-Za-z0-9_-][A-Za-z0-9._-]{0,127}\.png")  # as written
 PAGE_FILES = ("index.css", "gallery.js", "model-viewer-umd.min.js", "LICENSE-model-viewer.txt",
               "THIRD_PARTY_LICENSES.txt")
 
@@ -149,6 +153,23 @@ def real_size(rec: dict) -> dict | None:
             "mesh_cm": {str(k): _number(v) for k, v in mesh.items()}}
 
 
+def view_entries(folder: Path, rec: dict) -> list[dict]:
+    """An object's photographs (material.json `views`: several for an object seen from several sides, none
+    otherwise): name, picture (views/<name>.png, only a name of the form radar writes and only if the file is
+    there), used or left out and why, turn in degrees."""
+    views = rec.get("views")
+    entries = []
+    for view in views if isinstance(views, list) else []:
+        if not isinstance(view, dict):
+            continue
+        picture = view.get("picture")
+        ok = isinstance(picture, str) and VIEW_PICTURE.fullmatch(picture) and (folder / picture).is_file()
+        entries.append({"name": Path(str(view.get("source") or "")).stem, "picture": picture if ok else None,
+                        "used": view.get("used") is True, "reason": str(view.get("reason") or ""),
+                        "turn_deg": _number(view.get("turn_deg"))})
+    return entries
+
+
 def object_entry(folder: Path, rec: dict, catalogs: dict[Path, sqlite3.Connection]) -> dict:
     """What the page knows of one object: id, quality, material, attribution and which files exist."""
     quality = rec.get("quality")
@@ -166,6 +187,8 @@ def object_entry(folder: Path, rec: dict, catalogs: dict[Path, sqlite3.Connectio
         "size": real_size(rec),
         "relit": relit,
         "appendages": (folder / APPENDAGES_FILE).is_file(),
+        "views": view_entries(folder, rec),
+        "coverage": (folder / COVERAGE_FILE).is_file(),
         "thumbnail": (folder / THUMBNAIL_FILE).is_file(),
         "viewer_env": (folder / VIEWER_ENV_FILE).is_file(),
     }
