@@ -15,7 +15,7 @@ from radar_cli.masks import crop as crops
 from radar_cli.masks.appendages import Core, find_axis, symmetric_core, upright_rotation
 from radar_cli.masks.border import frame_inset
 from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fit_backdrop
-from radar_cli.masks.neighbours import base_off_axis, split_neighbour
+from radar_cli.masks.neighbours import base_off_axis, cut_behind, split_neighbour
 from radar_cli.masks.pipeline import (
     Refined,
     Settings,
@@ -230,7 +230,9 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
             raise InputError(f"{name}: no object stands out from the backdrop; crop it square or use --crop none")
         found = detections[0]
         refined = refine_detection(rgb, found, settings)
-    mask, neighbour = split_neighbour(refined.mask)
+    mask, neighbour = cut_behind(refined.mask)
+    if not neighbour:
+        mask, neighbour = split_neighbour(mask)
     mask, stand = remove_stand(open_gaps(mask, refined.image, refined.outside), refined.image)
     split: Core = symmetric_core(mask)
     final, image, core = refined.framed(rgb, split.core, settings, fill=255)  # beyond the frame: white

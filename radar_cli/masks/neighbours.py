@@ -1,11 +1,15 @@
 """Part a located vessel from a neighbour that the cut merged into it (a second vessel standing behind or
-beside it): the columns' extent over the lower part of the object rises a second time beyond the main vessel's
-flank; the object is cut at the valley between the two humps and the main (larger) one is kept.
+beside it).
+
+Behind it (`cut_behind`, tried first): the vessel in front hides part of the one behind, which stands higher;
+the neighbour widens one side of the object over a span of rows with the vessel's own outline above and below
+(its neck or rim, its foot), and that side is cut back to the mirror of the other. Beside it
+(`split_neighbour`): the columns' extent over the lower part of the object rises a second time beyond the main
+vessel's flank; the object is cut at the valley between the two humps and the main (larger) one is kept.
 
 Handles and rims reach out above the body, not down to the floor: only the lower rows are read. Where no
 valley parts them (a vessel behind overlapping the main one by much of its width), what lies off the main
-vessel's symmetric core in the lowest rows (`base_off_axis`) says a neighbour was probably kept with it.
-"""
+vessel's symmetric core in the lowest rows (`base_off_axis`) says a neighbour was probably kept with it."""
 
 from __future__ import annotations
 
@@ -77,3 +81,81 @@ def base_off_axis(whole: np.ndarray, core: np.ndarray) -> float:
     low = whole.copy()
     low[: rows.max() + 1 - int(BASE * (rows.max() - rows.min() + 1))] = False
     return float((low & ~core).sum() / max(int(low.sum()), 1))
+
+
+BEHIND_TOLERANCE = 0.03  # a row's midpoint within this fraction of the object's width of the axis is clean
+BEHIND_VIOLATE = 0.05  # the clean side may stick out past the mirrored other side on this share of the rows
+BEHIND_SPAN = 0.2  # a neighbour behind spans at least this share of the object's rows ...
+BEHIND_LOW = 0.6  # ... reaching below this share of the height from the top ...
+BEHIND_WIDE = 0.12  # ... sticks out past the mirror of the other side by this fraction of the width (median)
+BEHIND_END = 0.015  # ... with at least this share of the rows clean above it and below it (at least 3 rows) ...
+BEHIND_CLEAN = (0.3, 0.4)  # ... and at least these shares of the rows above it and below it clean ...
+BEHIND_FILL = 0.75  # ... and fills this share of its rows' span (a handle's loop does not) ...
+BEHIND_MAX = 0.4  # ... but holds at most this share of the object (the vessel in front hides much of it)
+
+
+def _behind_axis(mid: np.ndarray, side: int, tol: float) -> float:
+    """The axis x under the hypothesis that a neighbour widens only `side` (+1 right, -1 left): the rows'
+    midpoints lie on the axis or beyond it on that side, so the axis is at most (at least) their low (high)
+    quantile; among those, the x holding the most midpoints within `tol`."""
+    bound = np.quantile(side * mid, BEHIND_VIOLATE) + tol
+    candidates = np.unique(np.round(side * mid[side * mid <= bound] * 2) / 2)
+    counts = [int((np.abs(side * mid - c) <= tol).sum()) for c in candidates]
+    return float(side * candidates[int(np.argmax(counts))])
+
+
+def _behind_part(mask: np.ndarray, rows: np.ndarray, left: np.ndarray, right: np.ndarray, side: int,
+                 tol: float) -> np.ndarray | None:
+    """The n x n bool part of `mask` that a neighbour behind it on `side` adds, or None if none does (see
+    `cut_behind`). left, right: the outermost object column of each of `rows`."""
+    mid, height, width = (left + right) / 2, len(rows), right.max() - left.min() + 1
+    axis = _behind_axis(mid, side, tol)
+    outer, other = (right, left) if side > 0 else (left, right)
+    clip = 2 * axis - other + side * tol  # per row: the mirror of the other side, with the tolerance
+    cols = np.arange(mask.shape[1])
+    beyond = np.zeros_like(mask)
+    beyond[rows] = mask[rows] & (side * (cols[None, :] - clip[:, None]) > 0)
+    k = np.ones((2 * int(tol) + 1,) * 2, np.uint8)  # thin parts (a rim's or handle's end) are the vessel's own
+    beyond = cv2.morphologyEx(beyond.astype(np.uint8), cv2.MORPH_OPEN, k) > 0
+    count, labels, stats, _ = cv2.connectedComponentsWithStats(beyond.astype(np.uint8), connectivity=8)
+    if count <= 1:
+        return None
+    part = labels == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    held = np.nonzero(part[rows].any(1))[0]
+    top, bottom = int(held.min()), int(held.max())
+    clean = np.abs(mid - axis) <= tol
+    end = max(3, int(round(BEHIND_END * height)))
+    spans = side * (outer[top : bottom + 1] - clip[top : bottom + 1])
+    if (bottom - top + 1 < BEHIND_SPAN * height or bottom < BEHIND_LOW * height
+            or clean[:top].sum() < max(end, BEHIND_CLEAN[0] * top)
+            or clean[bottom + 1 :].sum() < max(end, BEHIND_CLEAN[1] * (height - bottom - 1))
+            or np.median(spans) < BEHIND_WIDE * width
+            or not MIN_PART * mask.sum() <= part.sum() <= BEHIND_MAX * mask.sum()
+            or part.sum() < BEHIND_FILL * np.maximum(spans, 0).sum()):
+        return None
+    return part
+
+
+def cut_behind(mask: np.ndarray) -> tuple[np.ndarray, bool]:
+    """The main vessel of a located n x n bool mask with a neighbour standing behind it cut off.
+
+    A neighbour behind the vessel is partly hidden by it and stands higher: it widens one side of the object
+    over a span of rows with the vessel's own outline above and below it (its foot; its neck or rim). Per side,
+    the vessel's axis is where those clean rows' midpoints gather (the other rows' lie beyond it on that side);
+    the neighbour is the largest part of the object past the mirror of the other side, and it is cut off where
+    it spans many rows down into the lower part, is solid and sticks out well.
+
+    Returns:
+        (mask, whether a neighbour was cut off).
+    """
+    rows = np.nonzero(mask.any(1))[0]
+    if len(rows) < 20:
+        return mask, False
+    cols = np.arange(mask.shape[1])
+    left = np.where(mask[rows], cols, mask.shape[1]).min(1).astype(np.float64)
+    right = np.where(mask[rows], cols, -1).max(1).astype(np.float64)
+    tol = max(1.5, BEHIND_TOLERANCE * (right.max() - left.min() + 1))
+    parts = [p for p in (_behind_part(mask, rows, left, right, side, tol) for side in (1, -1)) if p is not None]
+    if not parts:
+        return mask, False
+    return main_component(mask & ~max(parts, key=lambda p: int(p.sum()))), True

@@ -1,0 +1,61 @@
+"""A second vessel standing behind the located one (partly hidden by it, standing higher) is cut off; a lone
+vessel, a one-handled jug, a tilted vessel and a neighbour standing level beside it are left to the rest of the
+locator. The photos and masks are drawn here."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from radar_cli.masks import crop as crops
+from radar_cli.masks.locate import locate_object
+from radar_cli.masks.neighbours import cut_behind
+from radar_cli.masks.refine import iou
+
+H, W = 240, 220
+
+
+def vessel(cx: float, top: float, height: float, width: float) -> np.ndarray:
+    """H x W bool silhouette of an amphora-like vessel: rim, neck, a round body, a foot."""
+    y, x = np.mgrid[0:H, 0:W].astype(np.float64)
+    t = (y - top) / height  # 0 at the rim, 1 under the foot
+    body = 0.5 * np.sqrt(np.clip(1 - ((t - 0.55) / 0.4) ** 2, 0, 1))
+    neck = np.where((t >= 0.05) & (t < 0.25), 0.22, 0.0)
+    rim = np.where(t < 0.05, 0.3, 0.0)
+    foot = np.where((t >= 0.9) & (t <= 1.0), 0.2, 0.0)
+    radius = width * np.maximum.reduce([body, neck, rim, foot])
+    return (np.abs(x - cx) <= radius) & (t >= 0) & (t <= 1)
+
+
+def test_a_neighbour_behind_is_cut_at_the_mirror_of_the_other_side() -> None:
+    main = vessel(95, 20, 200, 120)
+    behind = vessel(165, 40, 160, 110)  # smaller, standing higher, a third of the main width hidden
+    cut, removed = cut_behind(main | behind)
+    assert removed and iou(cut, main) >= 0.95 and not (cut & ~(main | behind)).any()
+    alone, removed = cut_behind(main)
+    assert not removed and (alone == main).all()
+
+
+def test_vessels_of_their_own_shape_are_left_whole() -> None:
+    main = vessel(110, 20, 200, 120)
+    y, x = np.mgrid[0:H, 0:W]
+    ring = ((x - 175) / 22.0) ** 2 + ((y - 85) / 50.0) ** 2
+    jug = main | ((ring <= 1) & (ring >= 0.45) & (x > 150))  # a handle loop down to the body's widest rows
+    assert not cut_behind(jug)[1]
+    turn = cv2.getRotationMatrix2D((110, 120), 6.0, 1.0)  # a vessel photographed 6 degrees off upright
+    tilted = cv2.warpAffine(main.astype(np.uint8), turn, (W, H), flags=cv2.INTER_NEAREST) > 0
+    assert not cut_behind(tilted)[1]
+    beside = vessel(85, 20, 200, 110) | vessel(170, 20, 200, 110)  # standing level: no clean foot below it
+    assert not cut_behind(beside)[1]
+
+
+def test_a_vessel_in_front_of_another_is_located_without_it() -> None:
+    main, behind = vessel(95, 20, 200, 120), vessel(165, 40, 160, 110)
+    photo = np.full((H, W, 3), 150, np.uint8)
+    photo[behind] = (70, 45, 35)
+    photo[main] = (40, 30, 25)  # a black-glazed vessel in front of a darker brown one
+    noise = np.random.default_rng(0).normal(0, 2, photo.shape)
+    photo = np.clip(photo + noise, 0, 255).astype(np.uint8)
+    found = locate_object(photo, 128)
+    truth = crops.cut(main.astype(np.float32), found.box, 128, fill=0) > 0.5
+    assert found.neighbour_removed and iou(found.silhouette | found.appendages, truth) >= 0.9
