@@ -8,7 +8,8 @@ top views must not be `ok`; a whole vessel's side view must be `ok` unless its r
 on these level photographs, a catalogue ratio off by over 10 %, its solid's IoU with the silhouette under 0.85),
 `met_*` for ../shared/data/real_vases (EXPECTED_MET), names in a generated cases' truth.tsv
 (experiments.status_cases). `--rescore` judges the written files again with the code as it is (the same
-scores `radar derender` records, the outline support and the photo-edge records kept from material.json).
+scores `radar derender` records; the outline support, the photo-edge and the neighbour records, which need the
+photo before cropping, kept from material.json).
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from radar_cli.results import (
 
 MAX_PITCH, MAX_RATIO_ERROR, MIN_IOU = 8.0, 0.10, 0.85
 EXPECTED_MET = {"DP107005": "not", "DP250469": "not"}  # the head-shaped flasks: not solids of revolution
-KEPT = ("outline_support", "cut_edges", "frame_coverage")
+KEPT = ("outline_support", "cut_edges", "frame_coverage", "neighbour_cut", "base_off_axis")
 
 
 def rescore(folder: Path) -> dict:

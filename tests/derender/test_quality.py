@@ -38,6 +38,7 @@ def test_a_good_result_is_ok() -> None:
     ({"outline_support": 0.4}, "review", "off the object's edge"),
     ({"neighbour_cut": True}, "review", "neighbouring object was cut away"),
     ({"base_off_axis": 0.3}, "review", "another object probably merged"),
+    ({"foot_asymmetry": 0.05}, "review", "not a foot's level arc"),
     ({"silhouette_iou": None, "symmetry": None, "silhouette_area": None}, "review", "no silhouette"),
 ])
 def test_each_score_can_demote(change: dict, status: str, words: str) -> None:
@@ -103,10 +104,11 @@ def _painted(h: int, w: int, rng: np.random.Generator) -> np.ndarray:
     return np.where(pick[..., None], colours[0], colours[1]).astype(np.uint8)
 
 
-def _judged(photo: np.ndarray, sil: np.ndarray, rendered: np.ndarray, recon: np.ndarray) -> tuple[str, list[str]]:
+def _judged(photo: np.ndarray, sil: np.ndarray, rendered: np.ndarray, recon: np.ndarray,
+            app: np.ndarray | None = None) -> tuple[str, list[str]]:
     from radar_cli.derender.export.quality import fit_scores
 
-    return judge({**GOOD, **fit_scores(photo, sil, None, rendered, recon)})
+    return judge({**GOOD, **fit_scores(photo, sil, app, rendered, recon)})
 
 
 def test_a_clean_vase_stays_ok() -> None:
@@ -142,6 +144,25 @@ def test_a_sherd_cut_out_is_not_ok() -> None:
         solid[y] = np.abs(cols - 128) <= (xs.max() - xs.min()) / 2
     status, reasons = _judged(photo, sil, solid, photo)
     assert status == "review" and any("symmetric" in r or "sherd" in r for r in reasons), reasons
+
+
+def test_a_vase_broken_off_along_a_jagged_line_is_not_ok() -> None:
+    """A rendered vase's upper part, the rest broken off along a jagged line (as experiments.status_cases draws
+    it): the symmetric core and the solid stop level at the break, the broken edge below is left out as
+    appendage. The same vase whole, its solid drawing the foot a little wider than the photo, stays `ok`."""
+    photo, sil = _vase_on_white()
+    rows, cols = np.arange(256)[:, None], np.arange(256)
+    ys = np.nonzero(sil.any(1))[0]
+    walk = np.cumsum(np.random.default_rng(1).normal(0, 1, 256))
+    walk -= np.interp(cols, [0, 255], [walk[0], walk[-1]])
+    line = ys[0] + 0.55 * np.ptp(ys) + 0.08 * np.ptp(ys) * walk / np.abs(walk).max()
+    piece = sil & (rows <= line[None])
+    core = sil & (rows <= line[sil.any(0)].min())
+    photo_broken = np.where(piece[..., None], photo, 255).astype(np.uint8)
+    status, reasons = _judged(photo_broken, core, core, photo_broken, piece & ~core)
+    assert status == "review" and any("not a foot's level arc" in r for r in reasons), reasons
+    wider_foot = sil | (np.roll(sil, 2, 1) | np.roll(sil, -2, 1)) & (rows > ys[-1] - 0.1 * np.ptp(ys))
+    assert _judged(photo, sil, wider_foot, photo) == ("ok", [])
 
 
 def test_invented_highlights_are_flagged() -> None:

@@ -21,7 +21,7 @@ from radar_cli.derender.run.inputs import Prepared
 from radar_cli.derender.run.state import ObjectState
 from radar_cli.masks.crop import outside_mask
 from radar_cli.masks.outline import outline_support
-from radar_cli.masks.quality import outline_residual, roundness, sor_score
+from radar_cli.masks.quality import foot_asymmetry, outline_residual, roundness, sor_score
 from radar_cli.masks.refine import iou
 
 STATUSES = ("failed", "review", "ok")  # worst first: the order a curator reads them in
@@ -56,6 +56,9 @@ class QualityLimits:
     review_residual: float = 0.03
     """The solid's outline off the silhouette's by more than this share of its height: review (a broken edge,
     a sherd's outline)."""
+    review_foot: float = 0.03
+    """The object's lower outline further than this share of its height from mirror-symmetric about the solid's
+    axis (`foot_asymmetry`): review (a broken edge or a sherd, not a foot)."""
     review_roundness: float = 0.9
     """The object's silhouette this close to a filled ellipse or closer, with a lit rim round a dark inside
     (`review_rim`): review (a view into the mouth from above, not a side view)."""
@@ -136,6 +139,7 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
         "symmetry": None if sil is None else _round(sor_score(sil)),
         "object_symmetry": None if whole is None else _round(sor_score(whole)),
         "outline_residual": None if sil is None else _round(outline_residual(sil, rendered)),
+        "foot_asymmetry": None if whole is None else _round(foot_asymmetry(whole, rendered)),
         "roundness": None if whole is None else _round(roundness(whole)),
         "recon_psnr": _round(psnr(recon[region], photo[region]), 2) if region.any() else None,
         "mouth_error": _round(mouth_error(photo, recon, region & rendered, mouth)),
@@ -193,6 +197,9 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
          "is not turned, or a neighbour in the silhouette?"),
         ("outline_residual", lambda v: v > limits.review_residual,
          "the solid's outline is off the silhouette by {:.1%} of the height: a broken edge or a sherd?"),
+        ("foot_asymmetry", lambda v: v > limits.review_foot,
+         "the lower outline is uneven, not a foot's level arc ({:.1%} of the height off its mirror image): a "
+         "broken edge or a sherd?"),
         ("roundness", lambda v: v >= limits.review_roundness and (record.get("rim_contrast") or 0) >= limits.review_rim,
          "the silhouette is round ({:.2f}), a lit rim round a dark inside: a view from above into the mouth, "
          "not a side view?"),
