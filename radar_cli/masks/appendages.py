@@ -65,7 +65,8 @@ def upright_rotation(mask: np.ndarray, deg: float) -> np.ndarray:
     return cv2.getRotationMatrix2D((float(xs.mean()), float(ys.mean())), deg, 1.0)
 
 
-def _warp(mask: np.ndarray, affine: np.ndarray) -> np.ndarray:
+def turn_mask(mask: np.ndarray, affine: np.ndarray) -> np.ndarray:
+    """A bool mask moved by a 2 x 3 affine (bilinear, thresholded at one half), its size kept."""
     h, w = mask.shape
     out = cv2.warpAffine(mask.astype(np.float32), affine, (w, h), flags=cv2.INTER_LINEAR)
     return out > 0.5
@@ -78,10 +79,10 @@ def find_axis(mask: np.ndarray) -> tuple[float, float]:
     small = cv2.resize(mask.astype(np.uint8), None, fx=k, fy=k, interpolation=cv2.INTER_AREA) > 0
     best, best_tilt = -1.0, 0.0
     for deg in TILTS_DEG:
-        score, _ = mirror_agreement(_warp(small, upright_rotation(small, deg)) if deg else small)
+        score, _ = mirror_agreement(turn_mask(small, upright_rotation(small, deg)) if deg else small)
         if score > best:
             best, best_tilt = score, deg
-    upright = _warp(mask, upright_rotation(mask, best_tilt)) if best_tilt else mask
+    upright = turn_mask(mask, upright_rotation(mask, best_tilt)) if best_tilt else mask
     _, axis = mirror_agreement(upright)
     return best_tilt, axis
 
@@ -245,7 +246,7 @@ def symmetric_core(mask: np.ndarray) -> Core:
     tilt, axis = find_axis(mask)
     if tilt:
         rot = upright_rotation(mask, tilt)
-        core = _warp(upright_core(_warp(mask, rot), axis), cv2.invertAffineTransform(rot)) & mask
+        core = turn_mask(upright_core(turn_mask(mask, rot), axis), cv2.invertAffineTransform(rot)) & mask
     else:
         core = upright_core(mask, axis)
     rest = mask & ~core

@@ -16,6 +16,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from radar_cli.masks.quality import sor_score
 from radar_cli.masks.refine import main_component
 
 LOWER = 0.55  # the column profile counts object pixels in this lower share of the object's rows
@@ -92,6 +93,7 @@ BEHIND_END = 0.015  # ... with at least this share of the rows clean above it an
 BEHIND_CLEAN = (0.3, 0.4)  # ... and at least these shares of the rows above it and below it clean ...
 BEHIND_FILL = 0.75  # ... and fills this share of its rows' span (a handle's loop does not) ...
 BEHIND_MAX = 0.4  # ... but holds at most this share of the object (the vessel in front hides much of it)
+BEHIND_GAIN = 0.02  # the cut must raise the solid-of-revolution score (`quality.sor_score`) by this much
 
 
 def _behind_axis(mid: np.ndarray, side: int, tol: float) -> float:
@@ -143,7 +145,8 @@ def cut_behind(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     over a span of rows with the vessel's own outline above and below it (its foot; its neck or rim). Per side,
     the vessel's axis is where those clean rows' midpoints gather (the other rows' lie beyond it on that side);
     the neighbour is the largest part of the object past the mirror of the other side, and it is cut off where
-    it spans many rows down into the lower part, is solid and sticks out well.
+    it spans many rows down into the lower part, is solid and sticks out well, and the vessel left is more of a
+    solid of revolution than before (`BEHIND_GAIN`; a tilted vessel's flank passes the rest).
 
     Returns:
         (mask, whether a neighbour was cut off).
@@ -158,4 +161,7 @@ def cut_behind(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     parts = [p for p in (_behind_part(mask, rows, left, right, side, tol) for side in (1, -1)) if p is not None]
     if not parts:
         return mask, False
-    return main_component(mask & ~max(parts, key=lambda p: int(p.sum()))), True
+    cut = main_component(mask & ~max(parts, key=lambda p: int(p.sum())))
+    if sor_score(cut) < sor_score(mask) + BEHIND_GAIN:  # a tilted vessel's own flank, not a neighbour's
+        return mask, False
+    return cut, True
