@@ -308,7 +308,8 @@ def test_a_thousand_objects_paint_in_under_3_s(browser, results: Path, multiview
     page.close()
     server.shutdown()
     server.server_close()
-    print(f"\n1,000 objects ({'4' if several_views else '1'} views each): report {report_s:.2f} s, first contentful paint {paint_ms:.0f} ms, "
+    views = "4" if several_views else "1"
+    print(f"\n1,000 objects ({views} views each): report {report_s:.2f} s, first contentful paint {paint_ms:.0f} ms, "
           f"{cards} cards on the first page, all scrolled and thumbnails loaded after {scrolled_s:.2f} s, data.js "
           f"{(root / '.gallery' / 'data.js').stat().st_size / 1000:.0f} KB")
     assert cards == 120
