@@ -34,6 +34,8 @@ SEED_ROUNDS = 3  # ... this many times
 SEED_MIN_TOLERANCE = 8.0  # band pixels this close (RGB levels) to that surface are backdrop whatever its spread
 LIGHT_RANGE = (0.2, 1.6)  # brightness ratios to the backdrop model that shading of the backdrop can explain
 GREY_SPREAD = 4.0  # a photo whose channels differ by less than this (levels) almost everywhere is greyscale
+READING_SHARE = 0.25  # a reading whose largest object is under this share of another reading's does not count
+SHADING_LEAD = 0.05  # on a colour photo the reading that forgives shading wins unless beaten by this much support
 
 
 @dataclass(frozen=True)
@@ -344,6 +346,20 @@ def _support(small: np.ndarray, mask: np.ndarray) -> float:
     return (outline_support(small, mask) or 0.0) if mask.mean() >= MIN_AREA_FRAC else -1.0
 
 
+def _best_reading(small: np.ndarray, readings: list[tuple[np.ndarray, np.ndarray]], lead: tuple[float, ...]
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(evidence, object pixels, cleaned object) of the reading whose outline lies most on the photo's edges
+    (`_support` plus the reading's `lead`); a reading whose largest object is under READING_SHARE of another's
+    found only specks of the object (a low-contrast vessel taken for the backdrop's shading) and does not
+    count."""
+    cleaned = [_clean(raw) for _, raw in readings]
+    largest = [_largest_area(m) for m in cleaned]
+    scores = [_support(small, m) + bonus if area >= READING_SHARE * max(largest) else -1.0
+              for m, area, bonus in zip(cleaned, largest, lead)]
+    best = int(np.argmax(scores))
+    return readings[best][0], readings[best][1], cleaned[best]
+
+
 def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) -> list[Detection]:
     """Find the objects in a studio photograph.
 
@@ -359,13 +375,13 @@ def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) ->
     small, scale = downscale(image)
     padding = frame_padding(small)  # a flat frame round the picture: it must not join the object to its edges
     band = backdrop_band(small) & ~padding
-    # a greyscale photo is read twice, shading forgiven and not (a shadow, or a vessel a little darker than its
+    # the photo is read twice, shading forgiven and not (a shadow, or a vessel a little darker than its
     # backdrop?): the reading whose outline lies more on the photo's edges is kept (one that finds no object
-    # of MIN_AREA_FRAC does not count)
-    readings = [_cut(small, band, padding, threshold, thorough, shading) for shading in
-                ((True, False) if is_greyscale(small) else (True,))]
-    evidence, raw = max(readings, key=lambda r: _support(small, _clean(r[1])))
-    mask = _clean(raw)
+    # of MIN_AREA_FRAC does not count); on a colour photo the forgiving reading stands unless the other one's
+    # outline lies clearly more on edges (a dark vessel on a grey backdrop: its body passes for shade)
+    readings = [_cut(small, band, padding, threshold, thorough, shading) for shading in (True, False)]
+    lead = 0.0 if is_greyscale(small) else SHADING_LEAD
+    evidence, raw, mask = _best_reading(small, readings, (lead, 0.0))
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     if n <= 1:
         return []

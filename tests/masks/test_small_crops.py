@@ -92,6 +92,20 @@ def test_a_plain_grey_backdrop_is_located() -> None:
     assert located_iou(to_photo(canvas), truth) >= 0.9
 
 
+def test_a_black_glazed_vessel_on_a_plain_grey_close_to_it_is_located_whole() -> None:
+    """A neutral black glaze is the grey backdrop darkened (a shade's ratio, no colour of its own): read with
+    shading forgiven only the painted band stands out."""
+    image, mask = vessel(200, np.random.default_rng(6))
+    glaze = np.abs(image - np.array([0.18, 0.14, 0.12])).sum(axis=2) < 0.1
+    image[glaze] = image[glaze].mean(axis=1, keepdims=True) * 0.9
+    h, w = mask.shape
+    canvas = np.full((h + 12, w + 12, 3), 0.25, np.float32)
+    truth = np.zeros(canvas.shape[:2], bool)
+    place(canvas, truth, image, mask, 6, 6)
+    score = located_iou(to_photo(canvas), truth)
+    assert score >= 0.9, score
+
+
 def test_a_greyscale_catalogue_plate_cut_at_top_and_bottom() -> None:
     image, mask = vessel(200, np.random.default_rng(4))
     h, w = mask.shape
