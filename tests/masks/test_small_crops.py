@@ -81,12 +81,18 @@ def test_a_second_vessel_behind_is_not_merged() -> None:
     assert score >= 0.9, score
 
 
+def on_plain_grey(image: np.ndarray, mask: np.ndarray, level: float, margin: int) -> tuple[np.ndarray, np.ndarray]:
+    """The vessel on a flat grey of `level` with `margin` px all round: (canvas H x W x 3, its true silhouette)."""
+    h, w = mask.shape
+    canvas = np.full((h + 2 * margin, w + 2 * margin, 3), level, np.float32)
+    truth = np.zeros(canvas.shape[:2], bool)
+    place(canvas, truth, image, mask, margin, margin)
+    return canvas, truth
+
+
 def test_a_plain_grey_backdrop_is_located() -> None:
     image, mask = vessel(190, np.random.default_rng(3))
-    h, w = mask.shape
-    canvas = np.full((h + 10, w + 10, 3), 0.3, np.float32)
-    truth = np.zeros(canvas.shape[:2], bool)
-    place(canvas, truth, image, mask, 5, 5)
+    canvas, truth = on_plain_grey(image, mask, 0.3, 5)
     found = locate_object(to_photo(canvas), SIZE)
     assert found.frame_coverage < 0.9
     assert located_iou(to_photo(canvas), truth) >= 0.9
@@ -98,10 +104,7 @@ def test_a_black_glazed_vessel_on_a_plain_grey_close_to_it_is_located_whole() ->
     image, mask = vessel(200, np.random.default_rng(6))
     glaze = np.abs(image - np.array([0.18, 0.14, 0.12])).sum(axis=2) < 0.1
     image[glaze] = image[glaze].mean(axis=1, keepdims=True) * 0.9
-    h, w = mask.shape
-    canvas = np.full((h + 12, w + 12, 3), 0.25, np.float32)
-    truth = np.zeros(canvas.shape[:2], bool)
-    place(canvas, truth, image, mask, 6, 6)
+    canvas, truth = on_plain_grey(image, mask, 0.25, 6)
     score = located_iou(to_photo(canvas), truth)
     assert score >= 0.9, score
 
