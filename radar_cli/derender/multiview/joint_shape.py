@@ -60,7 +60,7 @@ def _polish(target: Outline, size: int, profile: torch.Tensor, height: torch.Ten
         opt.zero_grad()
         r, h, p = unpack()
         fit = outline_score(outline(Solid(r, h, p), size, camera), target).sum()
-        loss = fit + config.roughness_weight * views * roughness(r.mean(0, keepdim=True)).sum()
+        loss = fit + config.roughness_weight * views * roughness(r.mean(0, keepdim=True), config.corner).sum()
         loss.backward()
         opt.step()
     with torch.no_grad():
