@@ -14,7 +14,7 @@ import torch
 from radar_cli.config import CameraConfig
 from radar_cli.derender.multiview.fuse import FuseConfig, Fused, ViewTexture, fuse, match_exposure, unwrap_view
 from radar_cli.derender.multiview.joint_shape import Geometry, fit_jointly, profile_spread
-from radar_cli.derender.multiview.turns import TurnConfig, Turns, register_turns
+from radar_cli.derender.multiview.turns import TurnConfig, Turns, handle_phase, register_turns
 from radar_cli.derender.refine.driver import FIT_ERRORS, RefineReport, read_at_shape
 from radar_cli.derender.refine.fit_light import LightFitConfig
 from radar_cli.derender.refine.fit_shape import ShapeFit, ShapeFitConfig, fit_shape
@@ -246,7 +246,8 @@ def fit_chosen(views: list[ViewFit], predictor: Predictor, config: MultiviewConf
         read_appearance(view, predictor)
         view.texture = unwrap_texture(view, predictor)
     if turns is None:
-        found = register_turns([v.tex for v in used], config.turns)
+        found = register_turns([v.tex for v in used], config.turns,
+                               [handle_phase(v.mask, v.crops.appendages) for v in used])
     else:
         found = Turns(tuple(turns), (False,) * len(used), (float("nan"),) * len(used))
     for view, turn, registered, agreement in zip(used, found.degrees, found.registered, found.agreement):

@@ -3,7 +3,11 @@ unwrapped over 360 deg (multiview.fuse.unwrap_view) are compared where two views
 normalised cross-correlation of their detail along the angle (each row's slow changes, the shading the fit did not
 explain and the painted horizontal bands, taken out), at every turn between them. The turns that agree best over
 all pairs are chosen, near a prior of equal steps (a museum's A, A/B, B, B/A views: 90 deg) that only ranks
-near-ties: a view whose texture overlaps none of the others' keeps its step."""
+near-ties: a view whose texture overlaps none of the others' keeps its step. Where the locator split handles off
+the silhouettes, they place the views too: a view with a handle standing out on each side looks at the vessel
+between its handles, a view with one in front of the middle along them, so two views of the first kind are turned
+by a multiple of 180 deg from each other and by 90 or 270 from one of the second kind (`handle_phase`); the
+steps are assigned only as that allows."""
 
 from __future__ import annotations
 
@@ -11,6 +15,7 @@ import itertools
 import math
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 import torch
 import torch.nn.functional as F
@@ -18,6 +23,9 @@ import torch.nn.functional as F
 from radar_cli.derender.multiview.fuse import ViewTexture
 
 SPREAD_TIE_BREAK = 1e-6  # per degree of the smallest gap between views: decides only between equal scores
+HANDLE_SIDE = 0.75  # an appendage centred beyond this share of the half-width from the axis stands out at a side
+HANDLE_MIDDLE = 0.35  # ... one centred within this share stands in front of (or behind) the middle
+HANDLE_MIN_SHARE = 0.003  # appendage pieces under this share of the core's area are left out (specks, a label)
 
 
 @dataclass(frozen=True)
@@ -153,9 +161,44 @@ def _smallest_gap(slots: tuple[float, ...]) -> float:
     return min((b - a) % 360 or 360.0 for a, b in zip(ordered, ordered[1:] + ordered[:1]))
 
 
-def register_turns(views: list[ViewTexture], config: TurnConfig = TurnConfig()) -> Turns:
+def handle_phase(core: np.ndarray, appendages: np.ndarray | None) -> float | None:
+    """Where a view's handles stand about the axis, modulo 180 deg from the direction it looks at: 90 where pieces
+    of the appendages stand out on both sides of the silhouette (a two-handled vessel seen between its handles),
+    0 where they stand only in front of the middle (seen along its handles), None otherwise (none, one side only,
+    both kinds).
+
+    Args:
+        core: N x N bool silhouette's symmetric core; appendages: N x N bool pixels split off it (None: none).
+    """
+    if appendages is None or not appendages.any() or not core.any():
+        return None
+    cols = np.nonzero(core.any(0))[0]
+    axis, half = (cols[0] + cols[-1]) / 2.0, max((cols[-1] - cols[0]) / 2.0, 1.0)
+    n, _, stats, centres = cv2.connectedComponentsWithStats(appendages.astype(np.uint8), connectivity=8)
+    big = [i for i in range(1, n) if stats[i, cv2.CC_STAT_AREA] >= HANDLE_MIN_SHARE * core.sum()]
+    offsets = [(centres[i][0] - axis) / half for i in big]
+    left, right = any(o <= -HANDLE_SIDE for o in offsets), any(o >= HANDLE_SIDE for o in offsets)
+    middle = any(abs(o) <= HANDLE_MIDDLE for o in offsets)
+    if left and right and not middle:
+        return 90.0
+    if middle and not (left or right):
+        return 0.0
+    return None
+
+
+def _allowed(slots: tuple[float, ...], phases: list[float | None]) -> bool:
+    """Whether turns at these slots agree with the views' handle phases (handle_phase): a handle at object angle
+    h is seen by view k at h - turn_k, so turn_k - turn_j = phase_j - phase_k modulo 180."""
+    known = [(s, p) for s, p in zip(slots, phases) if p is not None]
+    return all(round((sk - sj - (pj - pk)) % 180.0) % 180 == 0
+               for (sj, pj), (sk, pk) in itertools.combinations(known, 2))
+
+
+def register_turns(views: list[ViewTexture], config: TurnConfig = TurnConfig(),
+                   phases: list[float | None] | None = None) -> Turns:
     """The turns of V views (each ViewTexture in its own frame) relative to the first: every assignment of the
-    views to distinct steps of the prior (or steps reused, with more views than steps) is polished by coordinate
+    views to distinct steps of the prior (or steps reused, with more views than steps) that the views' handle
+    phases allow (`phases`, handle_phase per view; all assignments where none does) is polished by coordinate
     ascent and the best total agreement kept."""
     count = len(views)
     details = [detail_map(v, config) for v in views]
@@ -166,11 +209,13 @@ def register_turns(views: list[ViewTexture], config: TurnConfig = TurnConfig()) 
         curves[(j, i)] = (np.roll(ncc[::-1], 1), np.roll(weight[::-1], 1))  # d -> -d
     steps = max(1, int(round(360 / config.step_deg)))
     others = range(1, steps)
-    choices = (itertools.permutations(others, count - 1) if count - 1 <= len(others)
-               else itertools.product(range(steps), repeat=count - 1))
+    choices = list(itertools.permutations(others, count - 1) if count - 1 <= len(others)
+                   else itertools.product(range(steps), repeat=count - 1))
+    candidates = [(0.0, *(c * config.step_deg for c in choice)) for choice in choices]
+    if phases is not None and any(_allowed(s, phases) for s in candidates):
+        candidates = [s for s in candidates if _allowed(s, phases)]
     best = (np.zeros(count), -np.inf)
-    for choice in choices:
-        slots = (0.0, *(c * config.step_deg for c in choice))
+    for slots in candidates:
         theta, total = _ascend(slots, curves, config)
         total += SPREAD_TIE_BREAK * _smallest_gap(slots)  # on a tie (no overlaps) the views spread round evenly
         if total > best[1]:
