@@ -33,7 +33,7 @@ def _candidates(mask: np.ndarray, pitches: list[float]):
     return closed_form(target, 256, torch.tensor(pitches, dtype=torch.float64), roll, tx, ShapeFitConfig(), CAMERA)
 
 
-def _search(grey: np.ndarray, mask: np.ndarray, config: ShapeFitConfig) -> tuple[float, str]:
+def searched_pitch(grey: np.ndarray, mask: np.ndarray, config: ShapeFitConfig) -> tuple[float, str]:
     """The searched pitch and its cue (fit_shape before the polish, which holds the pitch)."""
     target = mask_outline(downsample(mask, 256))
     image = torch.from_numpy(np.stack([grey, mask.astype(np.float32)]))[None]
@@ -51,9 +51,9 @@ def test_band_edges_are_straightest_at_the_true_pitch():
 
 def test_bands_pick_the_pitch_where_the_lip_is_fooled():
     grey, mask, truth = _banded_vase()
-    pitch, cue = _search(grey, mask, ShapeFitConfig())
+    pitch, cue = searched_pitch(grey, mask, ShapeFitConfig())
     assert cue == "band" and abs(pitch - truth) <= 0.5
-    fooled, cue = _search(grey, mask, dataclasses.replace(ShapeFitConfig(), band_ratio=float("inf")))
+    fooled, cue = searched_pitch(grey, mask, dataclasses.replace(ShapeFitConfig(), band_ratio=float("inf")))
     assert cue == "lip" and abs(fooled - truth) > 5.0
 
 

@@ -42,8 +42,8 @@ class RefineReport:
         status: `refined`, `fallback` (the network's prediction kept, see reason) or `off` (--refine none).
         reason: why it fell back ('' if it did not).
         resolution: side of the crop the fit ran at (px).
-        pitch_cue: `band` (painted bands), `lip` (the rim's front arc) or `outline` (the silhouette alone) picked
-            the pitch.
+        pitch_cue: `band` (painted bands), `lip` (the rim's front arc), `dark_lip` (that arc, its contrast taken
+            relative to its grey level) or `outline` (the silhouette alone) picked the pitch.
         outline_px: mean distance between the drawn and the located outline (px at `resolution`), refined /
             network.
         iou: silhouette IoU against the located one at `resolution`, refined / network.

@@ -60,6 +60,11 @@ class ShapeFitConfig:
             makes the outline read too high).
         lip_tie: coarse candidates whose lip is at least this fraction of the strongest count as tied; the
             outline picks among them.
+        lip_relative: without a lip above lip_contrast, one whose contrast divided by its two sides' mean grey
+            level (plus lip_dark) exceeds this is trusted (a black mouth over a dark neck: a faint edge, but
+            the mouth is several times darker; None: not looked for). Kraters' rims under a black or
+            decorated neck read at most 0.38, steep synthetic vases with a dark neck 0.6-1.1.
+        lip_dark: grey level added to the sides' mean before dividing (two black sides make no lip).
         lip_offset_px, fine_lip_offset_px: the lip's two sides are sampled this far above and below the arc (px
             at 512 px), on the coarse grid (wide: finds the lip) and on the fine one (narrow: places it).
         width_rounds: rounds of correct_widths at full resolution after the search.
@@ -80,6 +85,8 @@ class ShapeFitConfig:
     end_px: float = 2.0
     lip_contrast: float = 0.1
     lip_tie: float = 0.9
+    lip_relative: float | None = 0.5
+    lip_dark: float = 0.02
     prior_reach: float = 3.0
     band_ratio: float = 8.0
     band_reach: float = 1.0
@@ -99,7 +106,8 @@ class ShapeFit:
     Attributes:
         radius: 1 x rows radius column (fractions of r_max); height: 1; pose: 1 x 4 (pitch, roll, tx, ty).
         outline_error: mean distance in px (at the fitted resolution) between the fitted and the target outline.
-        pitch_cue: what picked the pitch: `band` (painted bands), `lip` (the rim's front arc) or `outline`.
+        pitch_cue: what picked the pitch: `band` (painted bands), `lip` (the rim's front arc), `dark_lip` (the
+            same arc, its contrast taken relative to its grey level) or `outline`.
     """
 
     radius: torch.Tensor
@@ -222,17 +230,18 @@ def closed_form(target: Outline, size: int, pitches: torch.Tensor, roll: float, 
 
 
 def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
-                 offset_px: float, camera: CameraConfig, samples: int = 512) -> torch.Tensor:
+                 offset_px: float, camera: CameraConfig, samples: int = 512) -> tuple[torch.Tensor, torch.Tensor]:
     """B contrasts of the rim's front arc: the mean grey level just below it (outer wall) minus just above it
-    (the inside, seen through the mouth), over the middle 80% of the arc, where both sides lie on the object.
+    (the inside, seen through the mouth), over the middle 80% of the arc, where both sides lie on the object;
+    and the mean grey level of both sides there.
 
     Args:
         grey: 1 x 2 x S x S: the grey image in [0, 1] and the object's coverage. radius: B x L; height: B;
             pose: B x 4.
 
     Returns:
-        B contrasts (0 where the rim's ellipse has no width, i.e. seen edge on, or where less than half of the
-        arc's samples lie on the object).
+        (B contrasts, B levels), both 0 where the rim's ellipse has no width, i.e. seen edge on, or where less
+        than half of the arc's samples lie on the object.
     """
     q = disc_conics(Solid(radius, height, pose), 2, camera)[:, 0]  # B x 3 x 3, the top disc
     x = torch.linspace(-1, 1, samples, dtype=torch.float64)
@@ -250,23 +259,27 @@ def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor,
     values = F.grid_sample(grey.expand(len(y), -1, -1, -1), points.float(), align_corners=False)  # B x 2 x 2 x N
     on_object = use & (values[:, 1].amin(dim=1) > 0.99)  # both sides well inside the silhouette
     diff = (values[:, 0, 1] - values[:, 0, 0]).double() * on_object
+    level = (values[:, 0, 1] + values[:, 0, 0]).double() / 2 * on_object
     enough = on_object.sum(1) >= 0.5 * use.sum(1).clamp_min(1)
-    return torch.where(enough, diff.sum(1) / on_object.sum(1).clamp_min(1), torch.zeros_like(diff[:, 0]))
+    count = on_object.sum(1).clamp_min(1)
+    zero = torch.zeros_like(diff[:, 0])
+    return torch.where(enough, diff.sum(1) / count, zero), torch.where(enough, level.sum(1) / count, zero)
 
 
 def _search(target: Outline, grey: torch.Tensor, size: int, pitches: torch.Tensor, roll: float, tx: float,
             config: ShapeFitConfig, camera: CameraConfig, lip_offset_px: float
             ) -> tuple[tuple[torch.Tensor, torch.Tensor, torch.Tensor], torch.Tensor, torch.Tensor, torch.Tensor,
-                       torch.Tensor]:
+                       torch.Tensor, torch.Tensor]:
     """Score a grid of candidate pitches: (shapes, outline + bending scores B, lip contrasts B, top-edge
-    errors B, outline + uncapped bending B)."""
+    errors B, outline + uncapped bending B, lip contrasts relative to their sides' grey level B)."""
     radius, height, pose = closed_form(target, size, pitches, roll, tx, config, camera)
     drawn = outline(Solid(radius, height, pose), size, camera)
     fit = outline_score(drawn, target)
     score = fit + config.roughness_weight * roughness(radius, config.corner)
     smooth = fit + config.roughness_weight * roughness(radius)
-    return ((radius, height, pose), score, lip_contrast(grey, radius, height, pose, lip_offset_px, camera),
-            top_error(drawn, target), smooth)
+    contrast, level = lip_contrast(grey, radius, height, pose, lip_offset_px, camera)
+    return ((radius, height, pose), score, contrast, top_error(drawn, target), smooth,
+            contrast / (level + config.lip_dark))
 
 
 def top_error(model: Outline, target: Outline) -> torch.Tensor:
@@ -278,15 +291,25 @@ def top_error(model: Outline, target: Outline) -> torch.Tensor:
     return diff.sum(1) / both.sum(1).clamp_min(1)
 
 
+def _lip_pick(lips: torch.Tensor, tie: torch.Tensor, config: ShapeFitConfig) -> int:
+    """Among candidates B whose lip (B, -inf outside the basin) is at least config.lip_tie of the strongest,
+    the best by `tie` (B): several arcs as strong as the best (an edge inside the mouth that many arcs cross),
+    the outline decides."""
+    strong = lips >= config.lip_tie * lips.max()
+    return int(torch.where(strong, tie, torch.full_like(tie, math.inf)).argmin())
+
+
 def _pick(score: torch.Tensor, contrast: torch.Tensor, coherence: torch.Tensor | None, pitches: torch.Tensor,
-          config: ShapeFitConfig, top: torch.Tensor | None = None,
-          smooth: torch.Tensor | None = None) -> tuple[int, str]:
+          config: ShapeFitConfig, top: torch.Tensor | None = None, smooth: torch.Tensor | None = None,
+          relative: torch.Tensor | None = None) -> tuple[int, str]:
     """The cue that picks among candidates B (all within the outline's basin, and within config.cue_basin_px
     of the best top edge, `top`, where given):
     - painted bands, where their coherence peaks at least config.band_ratio x its lowest: they bound the lip's
       search to config.band_reach of their peak (an edge above or below the rim can pass for it);
     - the strongest lip if that lip is strong enough (among near-ties, the best outline with the bending
       uncapped, `smooth`, where given: two arcs as strong, the smoother profile);
+    - else, the same way, the strongest lip relative to its sides' grey level (`relative`, B, where given) if
+      that is strong enough: a black mouth over a dark neck (cue `dark_lip`);
     - else the bands' peak, else the best outline score."""
     basin = score <= score.min() + config.basin
     if top is not None and config.cue_basin_px is not None:
@@ -297,12 +320,14 @@ def _pick(score: torch.Tensor, contrast: torch.Tensor, coherence: torch.Tensor |
         if float(peaks.max()) > config.band_ratio * max(float(coherence.min()), 1e-9):
             band = int(peaks.argmax())
             basin = basin & ((pitches - pitches[band]).abs() <= config.band_reach)
+    tie = score if smooth is None else smooth
     lips = torch.where(basin, contrast, torch.full_like(contrast, -math.inf))
     if float(lips.max()) > config.lip_contrast:
-        # several arcs as strong as the best (an edge inside the mouth that many arcs cross): the outline decides
-        strong = lips >= config.lip_tie * lips.max()
-        tie = score if smooth is None else smooth
-        return int(torch.where(strong, tie, torch.full_like(tie, math.inf)).argmin()), "lip"
+        return _lip_pick(lips, tie, config), "lip"
+    if relative is not None and config.lip_relative is not None:
+        dark = torch.where(basin, relative, torch.full_like(relative, -math.inf))
+        if float(dark.max()) > config.lip_relative:
+            return _lip_pick(dark, tie, config), "dark_lip"
     if band is not None:
         return band, "band"
     return int(score.argmin()), "outline"
@@ -320,10 +345,10 @@ def search_pitch(target: Outline, grey: torch.Tensor, size: int, config: ShapeFi
     middle of the range, so it reads the low pitches where the mouth is a sliver too high."""
     roll, tx = axis_from_outline(target, size, camera)
     coarse = torch.arange(0.0, config.pitch_max + 1e-6, config.coarse_step, dtype=torch.float64)
-    shapes, score, contrast, top, smooth = _search(target, grey, size, coarse, roll, tx, config, camera,
-                                                   config.lip_offset_px)
+    shapes, score, contrast, top, smooth, relative = _search(target, grey, size, coarse, roll, tx, config, camera,
+                                                             config.lip_offset_px)
     coherence = None if bands is None else band_coherence(bands[0], bands[1], *shapes, config.bands, camera)
-    best, cue = _pick(score, contrast, coherence, coarse, config, top, smooth)
+    best, cue = _pick(score, contrast, coherence, coarse, config, top, smooth, relative)
     if cue == "outline" and prior_pitch is not None:
         near = coarse - prior_pitch <= config.prior_reach
         if near.any():
@@ -331,8 +356,10 @@ def search_pitch(target: Outline, grey: torch.Tensor, size: int, config: ShapeFi
     centre = float(coarse[best])
     fine = torch.arange(centre - config.coarse_step, centre + config.coarse_step + 1e-6, config.fine_step,
                         dtype=torch.float64).clamp(0.0, config.pitch_max)
-    shapes, score, contrast, *_ = _search(target, grey, size, fine, roll, tx, config, camera, config.fine_lip_offset_px)
-    best = int(contrast.argmax()) if cue == "lip" else int(score.argmin())  # bands place no finer than the outline
+    shapes, score, contrast, _, _, relative = _search(target, grey, size, fine, roll, tx, config, camera,
+                                                      config.fine_lip_offset_px)
+    place = {"lip": contrast, "dark_lip": relative}.get(cue, -score)  # bands place no finer than the outline
+    best = int(place.argmax())
     return tuple(t[best : best + 1] for t in shapes), cue
 
 
