@@ -8,8 +8,9 @@ import dataclasses
 import functools
 
 import numpy as np
+import torch
 
-from radar_cli.derender.refine.fit_shape import ShapeFitConfig
+from radar_cli.derender.refine.fit_shape import ShapeFitConfig, _pick
 from radar_cli.synth.generator import SynthConfig, make_sample
 
 from .test_bands import searched_pitch
@@ -32,3 +33,22 @@ def test_a_dark_mouth_over_a_dark_neck_picks_the_steep_pitch():
     level, cue = searched_pitch(grey, mask, dataclasses.replace(ShapeFitConfig(), lip_relative=None))
     assert cue == "outline" and pitch - level > 10.0, level  # the silhouette alone reads it level
 
+
+
+def test_bands_too_faint_to_pick_still_rule_a_dark_lip_out():
+    """An oinochoe's trefoil mouth shows its dark inside at a level view: a relative lip at 13 deg, where the
+    painted bands are half as straight as at 3 deg, must not pick (the outline does)."""
+    pitches = torch.arange(0.0, 25.5, 0.5, dtype=torch.float64)
+    score = 1.0 + 0.01 * pitches  # every candidate in the outline's basin, the level one best
+    contrast = torch.zeros_like(pitches)  # no plain lip
+    relative = torch.where((pitches - 13.0).abs() < 0.3, 0.8, 0.0).double()
+    coherence = (0.06 + 0.15 * torch.exp(-0.5 * ((pitches - 3.0) / 2.0) ** 2)).double()  # peak 3.5x its lowest
+    config = ShapeFitConfig()
+    best, cue = _pick(score, contrast, coherence, pitches, config, relative=relative)
+    assert cue == "outline" and float(pitches[best]) == 0.0
+    near_peak = torch.where((pitches - 3.5).abs() < 0.3, 0.8, 0.0).double()  # the dark lip where the bands agree
+    best, cue = _pick(score, contrast, coherence, pitches, config, relative=near_peak)
+    assert cue == "dark_lip" and float(pitches[best]) == 3.5
+    best, cue = _pick(score, contrast, coherence, pitches, dataclasses.replace(config, dark_lip_bands=None),
+                      relative=relative)
+    assert cue == "dark_lip" and float(pitches[best]) == 13.0  # unchecked, the trefoil's inside would pick

@@ -65,6 +65,9 @@ class ShapeFitConfig:
             the mouth is several times darker; None: not looked for). Kraters' rims under a black or
             decorated neck read at most 0.38, steep synthetic vases with a dark neck 0.6-1.1.
         lip_dark: grey level added to the sides' mean before dividing (two black sides make no lip).
+        dark_lip_bands: the relative lip picks only among candidates whose painted bands' coherence is at least
+            this share of the basin's highest (bands too faint to pick still say which pitches they rule out:
+            an oinochoe's trefoil mouth shows its dark inside at a level view; None: not checked).
         lip_offset_px, fine_lip_offset_px: the lip's two sides are sampled this far above and below the arc (px
             at 512 px), on the coarse grid (wide: finds the lip) and on the fine one (narrow: places it).
         width_rounds: rounds of correct_widths at full resolution after the search.
@@ -87,6 +90,7 @@ class ShapeFitConfig:
     lip_tie: float = 0.9
     lip_relative: float | None = 0.5
     lip_dark: float = 0.02
+    dark_lip_bands: float | None = 0.6
     prior_reach: float = 3.0
     band_ratio: float = 8.0
     band_reach: float = 1.0
@@ -309,7 +313,8 @@ def _pick(score: torch.Tensor, contrast: torch.Tensor, coherence: torch.Tensor |
     - the strongest lip if that lip is strong enough (among near-ties, the best outline with the bending
       uncapped, `smooth`, where given: two arcs as strong, the smoother profile);
     - else, the same way, the strongest lip relative to its sides' grey level (`relative`, B, where given) if
-      that is strong enough: a black mouth over a dark neck (cue `dark_lip`);
+      that is strong enough, among candidates the bands do not rule out (config.dark_lip_bands): a black mouth
+      over a dark neck (cue `dark_lip`);
     - else the bands' peak, else the best outline score."""
     basin = score <= score.min() + config.basin
     if top is not None and config.cue_basin_px is not None:
@@ -326,6 +331,9 @@ def _pick(score: torch.Tensor, contrast: torch.Tensor, coherence: torch.Tensor |
         return _lip_pick(lips, tie, config), "lip"
     if relative is not None and config.lip_relative is not None:
         dark = torch.where(basin, relative, torch.full_like(relative, -math.inf))
+        if coherence is not None and config.dark_lip_bands is not None:
+            highest = torch.where(basin, coherence, torch.full_like(coherence, -math.inf)).max()
+            dark = torch.where(coherence >= config.dark_lip_bands * highest, dark, torch.full_like(dark, -math.inf))
         if float(dark.max()) > config.lip_relative:
             return _lip_pick(dark, tie, config), "dark_lip"
     if band is not None:
