@@ -10,7 +10,8 @@ import functools
 import numpy as np
 import torch
 
-from radar_cli.derender.refine.fit_shape import ShapeFitConfig, _pick
+from radar_cli.derender.refine.fit_shape import ShapeFitConfig
+from radar_cli.derender.refine.pitch_cues import pick_cue
 from radar_cli.synth.generator import SynthConfig, make_sample
 
 from .test_bands import searched_pitch
@@ -44,11 +45,11 @@ def test_bands_too_faint_to_pick_still_rule_a_dark_lip_out():
     relative = torch.where((pitches - 13.0).abs() < 0.3, 0.8, 0.0).double()
     coherence = (0.06 + 0.15 * torch.exp(-0.5 * ((pitches - 3.0) / 2.0) ** 2)).double()  # peak 3.5x its lowest
     config = ShapeFitConfig()
-    best, cue = _pick(score, contrast, coherence, pitches, config, relative=relative)
+    best, cue = pick_cue(score, contrast, coherence, pitches, config, relative=relative)
     assert cue == "outline" and float(pitches[best]) == 0.0
     near_peak = torch.where((pitches - 3.5).abs() < 0.3, 0.8, 0.0).double()  # the dark lip where the bands agree
-    best, cue = _pick(score, contrast, coherence, pitches, config, relative=near_peak)
+    best, cue = pick_cue(score, contrast, coherence, pitches, config, relative=near_peak)
     assert cue == "dark_lip" and float(pitches[best]) == 3.5
-    best, cue = _pick(score, contrast, coherence, pitches, dataclasses.replace(config, dark_lip_bands=None),
+    best, cue = pick_cue(score, contrast, coherence, pitches, dataclasses.replace(config, dark_lip_bands=None),
                       relative=relative)
     assert cue == "dark_lip" and float(pitches[best]) == 13.0  # unchecked, the trefoil's inside would pick

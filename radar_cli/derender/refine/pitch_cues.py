@@ -1,0 +1,112 @@
+"""The cues that pick the pitch among candidates scored by the outline (derender.refine.fit_shape,
+docs/refinement.md): where the open mouth is visible, the rim's front arc is an edge (the inside darker than the
+outer wall below the lip; `lip_contrast`, also relative to its grey level where mouth and neck are both dark);
+painted bands (derender.refine.bands) pick the pitch or bound the lip's search; the top edge (`top_error`) keeps
+the lip and the bands to candidates that draw the photograph's rim."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import torch
+import torch.nn.functional as F
+
+from radar_cli.config import CameraConfig
+from radar_cli.sor.outline import Outline, disc_conics, roots
+from radar_cli.sor.solid import Solid
+
+if TYPE_CHECKING:
+    from radar_cli.derender.refine.fit_shape import ShapeFitConfig
+
+
+def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
+                 offset_px: float, camera: CameraConfig, samples: int = 512) -> tuple[torch.Tensor, torch.Tensor]:
+    """B contrasts of the rim's front arc: the mean grey level just below it (outer wall) minus just above it
+    (the inside, seen through the mouth), over the middle 80% of the arc, where both sides lie on the object;
+    and the mean grey level of both sides there.
+
+    Args:
+        grey: 1 x 2 x S x S: the grey image in [0, 1] and the object's coverage. radius: B x L; height: B;
+            pose: B x 4.
+
+    Returns:
+        (B contrasts, B levels), both 0 where the rim's ellipse has no width, i.e. seen edge on, or where less
+        than half of the arc's samples lie on the object.
+    """
+    q = disc_conics(Solid(radius, height, pose), 2, camera)[:, 0]  # B x 3 x 3, the top disc
+    x = torch.linspace(-1, 1, samples, dtype=torch.float64)
+    # the rim's front arc: per column, the lower root y of the top disc's conic (y up)
+    front, _ = roots(q[:, 1, 1, None].expand(-1, samples), q[:, 0, 1, None] * x + q[:, 1, 2, None],
+                     q[:, 0, 0, None] * x * x + 2 * q[:, 0, 2, None] * x + q[:, 2, 2, None])  # B x N
+    covered = ~front.isnan()
+    lo = torch.where(covered, x, torch.full_like(front, math.inf)).amin(1, keepdim=True)
+    hi = torch.where(covered, x, torch.full_like(front, -math.inf)).amax(1, keepdim=True)
+    use = covered & ((x - (lo + hi) / 2).abs() <= 0.4 * (hi - lo))  # B x N
+    step = offset_px * 2 / 512
+    y = torch.nan_to_num(front)
+    points = torch.stack([torch.stack([x.expand_as(y), -(y + step)], -1),  # above the arc (inside); rows down
+                          torch.stack([x.expand_as(y), -(y - step)], -1)], 1)  # below the arc (outer wall)
+    values = F.grid_sample(grey.expand(len(y), -1, -1, -1), points.float(), align_corners=False)  # B x 2 x 2 x N
+    on_object = use & (values[:, 1].amin(dim=1) > 0.99)  # both sides well inside the silhouette
+    diff = (values[:, 0, 1] - values[:, 0, 0]).double() * on_object
+    level = (values[:, 0, 1] + values[:, 0, 0]).double() / 2 * on_object
+    enough = on_object.sum(1) >= 0.5 * use.sum(1).clamp_min(1)
+    count = on_object.sum(1).clamp_min(1)
+    zero = torch.zeros_like(diff[:, 0])
+    return torch.where(enough, diff.sum(1) / count, zero), torch.where(enough, level.sum(1) / count, zero)
+
+
+def top_error(model: Outline, target: Outline) -> torch.Tensor:
+    """B mean |distances| (px) between the top ends of a batch of outlines and the target's, over the columns
+    both cover: how well each candidate's rim (its back arc, where the mouth shows) draws the photograph's top
+    edge."""
+    both = ~(model.top.isnan() | target.top.isnan())
+    diff = torch.where(both, (model.top - target.top.expand_as(model.top)).abs(), torch.zeros_like(model.top))
+    return diff.sum(1) / both.sum(1).clamp_min(1)
+
+
+def _lip_pick(lips: torch.Tensor, tie: torch.Tensor, config: ShapeFitConfig) -> int:
+    """Among candidates B whose lip (B, -inf outside the basin) is at least config.lip_tie of the strongest,
+    the best by `tie` (B): several arcs as strong as the best (an edge inside the mouth that many arcs cross),
+    the outline decides."""
+    strong = lips >= config.lip_tie * lips.max()
+    return int(torch.where(strong, tie, torch.full_like(tie, math.inf)).argmin())
+
+
+def pick_cue(score: torch.Tensor, contrast: torch.Tensor, coherence: torch.Tensor | None, pitches: torch.Tensor,
+          config: ShapeFitConfig, top: torch.Tensor | None = None, smooth: torch.Tensor | None = None,
+          relative: torch.Tensor | None = None) -> tuple[int, str]:
+    """The cue that picks among candidates B (all within the outline's basin, and within config.cue_basin_px
+    of the best top edge, `top`, where given):
+    - painted bands, where their coherence peaks at least config.band_ratio x its lowest: they bound the lip's
+      search to config.band_reach of their peak (an edge above or below the rim can pass for it);
+    - the strongest lip if that lip is strong enough (among near-ties, the best outline with the bending
+      uncapped, `smooth`, where given: two arcs as strong, the smoother profile);
+    - else, the same way, the strongest lip relative to its sides' grey level (`relative`, B, where given) if
+      that is strong enough, among candidates the bands do not rule out (config.dark_lip_bands): a black mouth
+      over a dark neck (cue `dark_lip`);
+    - else the bands' peak, else the best outline score."""
+    basin = score <= score.min() + config.basin
+    if top is not None and config.cue_basin_px is not None:
+        basin = basin & (top <= top.min() + config.cue_basin_px)
+    band = None
+    if coherence is not None:
+        peaks = torch.where(basin, coherence, torch.full_like(coherence, -math.inf))
+        if float(peaks.max()) > config.band_ratio * max(float(coherence.min()), 1e-9):
+            band = int(peaks.argmax())
+            basin = basin & ((pitches - pitches[band]).abs() <= config.band_reach)
+    tie = score if smooth is None else smooth
+    lips = torch.where(basin, contrast, torch.full_like(contrast, -math.inf))
+    if float(lips.max()) > config.lip_contrast:
+        return _lip_pick(lips, tie, config), "lip"
+    if relative is not None and config.lip_relative is not None:
+        dark = torch.where(basin, relative, torch.full_like(relative, -math.inf))
+        if coherence is not None and config.dark_lip_bands is not None:
+            highest = torch.where(basin, coherence, torch.full_like(coherence, -math.inf)).max()
+            dark = torch.where(coherence >= config.dark_lip_bands * highest, dark, torch.full_like(dark, -math.inf))
+        if float(dark.max()) > config.lip_relative:
+            return _lip_pick(dark, tie, config), "dark_lip"
+    if band is not None:
+        return band, "band"
+    return int(score.argmin()), "outline"
