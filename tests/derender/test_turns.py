@@ -66,3 +66,18 @@ def test_handle_phases_are_read_from_the_split_silhouette() -> None:
     assert handle_phase(core, one_side) is None
     assert handle_phase(core, sides | middle) is None
     assert handle_phase(core, None) is None
+
+
+def test_a_turn_beyond_the_reach_of_every_step_keeps_its_step(views, monkeypatch) -> None:
+    """Two views whose textures agree best 125 deg apart (35 from the nearest step, beyond the 30 deg reach):
+    within reach the agreement only rises towards its edge, so the turn is the prior's step, not registered."""
+    from radar_cli.derender.multiview import turns as module
+
+    peak = np.exp(-0.5 * ((np.arange(360) - 125.0) / 20.0) ** 2)  # one broad peak at 125 deg
+    monkeypatch.setattr(module, "correlation", lambda a, b, config: (peak, np.ones(360)))
+    found = register_turns(views[:2])
+    assert not found.registered[1], found
+    assert found.degrees[1] in (90.0, 180.0, 270.0), found.degrees
+    monkeypatch.setattr(module, "correlation", lambda a, b, config: (np.roll(peak, -20), np.ones(360)))
+    found = register_turns(views[:2])  # a peak at 105, within reach of 90: found
+    assert found.registered[1] and abs(found.degrees[1] - 105.0) <= 1.0, found

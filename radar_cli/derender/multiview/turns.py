@@ -62,7 +62,8 @@ class Turns:
 
     Attributes:
         degrees: per view, its turn relative to the first (0 for the first), in [0, 360).
-        registered: per view, whether its texture overlapped another view's (False: the prior's step kept).
+        registered: per view, whether its turn came from the textures (False: the prior's step kept: its texture
+            overlapped no other view's, or agreed best only at the edge of the reach).
         agreement: per view, the mean correlation with the views it overlaps at the chosen turns (NaN: none).
     """
 
@@ -199,7 +200,8 @@ def register_turns(views: list[ViewTexture], config: TurnConfig = TurnConfig(),
     """The turns of V views (each ViewTexture in its own frame) relative to the first: every assignment of the
     views to distinct steps of the prior (or steps reused, with more views than steps) that the views' handle
     phases allow (`phases`, handle_phase per view; all assignments where none does) is polished by coordinate
-    ascent and the best total agreement kept."""
+    ascent and the best total agreement kept. A turn that ends at the edge of its reach found no peak there and
+    keeps its step (not registered)."""
     count = len(views)
     details = [detail_map(v, config) for v in views]
     curves = {}
@@ -214,18 +216,22 @@ def register_turns(views: list[ViewTexture], config: TurnConfig = TurnConfig(),
     candidates = [(0.0, *(c * config.step_deg for c in choice)) for choice in choices]
     if phases is not None and any(_allowed(s, phases) for s in candidates):
         candidates = [s for s in candidates if _allowed(s, phases)]
-    best = (np.zeros(count), -np.inf)
+    best: tuple[np.ndarray, float, tuple[float, ...]] = (np.zeros(count), -np.inf, candidates[0])
     for slots in candidates:
         theta, total = _ascend(slots, curves, config)
         total += SPREAD_TIE_BREAK * _smallest_gap(slots)  # on a tie (no overlaps) the views spread round evenly
         if total > best[1]:
-            best = (theta, total)
-    theta = best[0]
+            best = (theta, total, slots)
+    theta, _, slots = best
     registered, agreement = [True], [float("nan")]
     for k in range(1, count):
+        off = (theta[k] - slots[k] + 180.0) % 360.0 - 180.0
+        edge = abs(off) >= config.reach_deg - 1.0  # no peak within reach: the agreement only rose towards its edge
+        if edge:
+            theta[k] = slots[k]
         pairs = [(curves[(j, k)][0][int(round(theta[k] - theta[j])) % 360],
                   curves[(j, k)][1][int(round(theta[k] - theta[j])) % 360]) for j in range(count) if j != k]
         used = [c for c, w in pairs if w > 0]
-        registered.append(bool(used))
+        registered.append(bool(used) and not edge)
         agreement.append(float(np.mean(used)) if used else float("nan"))
     return Turns(tuple(float(t % 360) for t in theta), tuple(registered), tuple(agreement))
