@@ -11,7 +11,8 @@ import torch
 
 from radar_cli.config import CameraConfig
 from radar_cli.derender.refine.bands import BandCue, band_coherence, high_pass
-from radar_cli.derender.refine.fit_shape import ShapeFitConfig, axis_from_outline, closed_form, downsample, search_pitch
+from radar_cli.derender.refine.fit_shape import axis_from_outline, closed_form, downsample, search_pitch
+from radar_cli.derender.refine.shape_config import ShapeFitConfig
 from radar_cli.sor.outline import mask_outline
 from radar_cli.synth.generator import SynthConfig, make_sample
 

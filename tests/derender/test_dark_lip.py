@@ -10,8 +10,8 @@ import functools
 import numpy as np
 import torch
 
-from radar_cli.derender.refine.fit_shape import ShapeFitConfig
 from radar_cli.derender.refine.pitch_cues import pick_cue
+from radar_cli.derender.refine.shape_config import ShapeFitConfig
 from radar_cli.synth.generator import SynthConfig, make_sample
 
 from .test_bands import searched_pitch

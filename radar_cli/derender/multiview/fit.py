@@ -17,7 +17,8 @@ from radar_cli.derender.multiview.joint_shape import Geometry, fit_jointly, prof
 from radar_cli.derender.multiview.turns import TurnConfig, Turns, handle_phase, register_turns
 from radar_cli.derender.refine.driver import FIT_ERRORS, RefineReport, read_at_shape
 from radar_cli.derender.refine.fit_light import LightFitConfig
-from radar_cli.derender.refine.fit_shape import ShapeFit, ShapeFitConfig, fit_shape
+from radar_cli.derender.refine.fit_shape import ShapeFit, fit_shape
+from radar_cli.derender.refine.shape_config import ShapeFitConfig
 from radar_cli.derender.run.inputs import Prepared
 from radar_cli.derender.run.predictor import Predictor
 from radar_cli.derender.run.state import ObjectState, quantise

@@ -8,7 +8,8 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig
-from radar_cli.derender.refine.fit_shape import ShapeFit, ShapeFitConfig, downsample, outline_score, roughness
+from radar_cli.derender.refine.fit_shape import ShapeFit, downsample, outline_score, roughness
+from radar_cli.derender.refine.shape_config import ShapeFitConfig
 from radar_cli.sor.outline import Outline, mask_outline, outline
 from radar_cli.sor.solid import Solid
 

@@ -18,7 +18,8 @@ import torch
 
 from radar_cli.config import CameraConfig
 from radar_cli.derender.refine.fit_light import LightFitConfig, fit_environment
-from radar_cli.derender.refine.fit_shape import ShapeFitConfig, fit_shape, outline_score
+from radar_cli.derender.refine.fit_shape import fit_shape, outline_score
+from radar_cli.derender.refine.shape_config import ShapeFitConfig
 from radar_cli.masks.refine import iou
 from radar_cli.model.outputs import Decomposition
 from radar_cli.model.specular_reader import SpecularReader

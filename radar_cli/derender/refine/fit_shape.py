@@ -22,86 +22,12 @@ import torch
 import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig
-from radar_cli.derender.refine.bands import BandCue, band_coherence, high_pass
+from radar_cli.derender.refine.bands import band_coherence, high_pass
 from radar_cli.derender.refine.pitch_cues import lip_contrast, pick_cue, top_error
+from radar_cli.derender.refine.shape_config import ShapeFitConfig
 from radar_cli.sor.outline import Outline, mask_outline, outline, vertical_extent
 from radar_cli.sor.pose import rotation_matrix, translation
 from radar_cli.sor.solid import Solid
-
-
-@dataclass(frozen=True)
-class ShapeFitConfig:
-    """How the shape and pose are fitted (weights chosen on 24 vases of `radar synth --size 512 --seed 5`;
-    docs/refinement.md).
-
-    Attributes:
-        rows: profile rows fitted.
-        grid_size: outline resolution of the pitch grids (px).
-        pitch_max: the grids cover 0..pitch_max degrees.
-        coarse_step, fine_step: the pitch grids (the fine one spans +- coarse_step round the coarse pick).
-        roughness_weight: the profile's bending (sum of squared second differences x 1e3, at 64 rows).
-        corner: a second difference counts at most this much (a moulding, a lip, a foot's step is a corner of a
-            real profile: charged once, whatever its size; None: no cap). Uncapped, the steps of an overhanging
-            rim and a stepped foot, sharp at the right (level) pitch, are smoothed by the ellipses of a steep
-            one, and the bending term drove level photographs of kraters to 10-25 deg.
-        basin: the lip may pick any candidate whose outline score is within this of the best.
-        cue_basin_px: the lip and the bands pick only among candidates whose top edge (the rim's back arc
-            where the mouth shows) is within this of the best one's (px at grid_size; None: no such bound):
-            where the photograph's top edge is straight, the rim is seen edge on and no mouth is drawn, whatever
-            edge or pattern below it looks like a lip.
-        end_px: the profile's end rows are read at least this far (px at 256) inside the outline's first and
-            last rows (profile_from_widths).
-        lip_contrast: the lip is trusted where its contrast (grey levels 0..1) exceeds this.
-        band_ratio: painted bands pick the pitch where their coherence peaks at least this many times its lowest
-            over the grid.
-        band_reach: where they do, the lip is looked for within this of their peak (degrees).
-        bands: how the bands are read (derender.refine.bands).
-        prior_reach: without bands or a lip, the outline's pick stays at most this above the network's pitch (degrees);
-            below it the outline is free (the network reads low pitches too high; a thick rim or a bevelled foot
-            makes the outline read too high).
-        lip_tie: coarse candidates whose lip is at least this fraction of the strongest count as tied; the
-            outline picks among them.
-        lip_relative: without a lip above lip_contrast, one whose contrast divided by its two sides' mean grey
-            level (plus lip_dark) exceeds this is trusted (a black mouth over a dark neck: a faint edge, but
-            the mouth is several times darker; None: not looked for). Kraters' rims under a black or
-            decorated neck read at most 0.38, steep synthetic vases with a dark neck 0.6-1.1.
-        lip_dark: grey level added to the sides' mean before dividing (two black sides make no lip).
-        dark_lip_bands: the relative lip picks only among candidates whose painted bands' coherence is at least
-            this share of the basin's highest (bands too faint to pick still say which pitches they rule out:
-            an oinochoe's trefoil mouth shows its dark inside at a level view; None: not checked).
-        lip_offset_px, fine_lip_offset_px: the lip's two sides are sampled this far above and below the arc (px
-            at 512 px), on the coarse grid (wide: finds the lip) and on the fine one (narrow: places it).
-        width_rounds: rounds of correct_widths at full resolution after the search.
-        polish_steps: Adam steps at grid_size, then at full resolution, pitch held.
-        polish_lr: their step (radii, height and offsets in hundredths of r_max, roll in degrees).
-        placement_iterations: closed-form rounds of profile, height and vertical offset per candidate.
-    """
-
-    rows: int = 64
-    grid_size: int = 256
-    pitch_max: float = 25.0
-    coarse_step: float = 0.5
-    fine_step: float = 0.1
-    roughness_weight: float = 0.5
-    corner: float | None = 0.005
-    basin: float = 3.0
-    cue_basin_px: float | None = 1.0
-    end_px: float = 2.0
-    lip_contrast: float = 0.1
-    lip_tie: float = 0.9
-    lip_relative: float | None = 0.5
-    lip_dark: float = 0.02
-    dark_lip_bands: float | None = 0.6
-    prior_reach: float = 3.0
-    band_ratio: float = 8.0
-    band_reach: float = 1.0
-    bands: BandCue = BandCue()
-    lip_offset_px: float = 2.0
-    fine_lip_offset_px: float = 1.0
-    width_rounds: int = 3
-    polish_steps: tuple[int, int] = (40, 10)
-    polish_lr: float = 0.05
-    placement_iterations: int = 3
 
 
 @dataclass(frozen=True)

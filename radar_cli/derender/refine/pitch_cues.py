@@ -7,17 +7,14 @@ the lip and the bands to candidates that draw the photograph's rim."""
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import torch
 import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig
+from radar_cli.derender.refine.shape_config import ShapeFitConfig
 from radar_cli.sor.outline import Outline, disc_conics, roots
 from radar_cli.sor.solid import Solid
-
-if TYPE_CHECKING:
-    from radar_cli.derender.refine.fit_shape import ShapeFitConfig
 
 
 def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
