@@ -211,8 +211,8 @@ def register_turns(views: list[ViewTexture], config: TurnConfig = TurnConfig(),
         curves[(j, i)] = (np.roll(ncc[::-1], 1), np.roll(weight[::-1], 1))  # d -> -d
     steps = max(1, int(round(360 / config.step_deg)))
     others = range(1, steps)
-    choices = list(itertools.permutations(others, count - 1) if count - 1 <= len(others)
-                   else itertools.product(range(steps), repeat=count - 1))
+    choices = (itertools.permutations(others, count - 1) if count - 1 <= len(others)
+               else itertools.product(range(steps), repeat=count - 1))
     candidates = [(0.0, *(c * config.step_deg for c in choice)) for choice in choices]
     if phases is not None and any(_allowed(s, phases) for s in candidates):
         candidates = [s for s in candidates if _allowed(s, phases)]
