@@ -71,9 +71,14 @@ def _lip_pick(lips: torch.Tensor, tie: torch.Tensor, config: ShapeFitConfig) -> 
     return int(torch.where(strong, tie, torch.full_like(tie, math.inf)).argmin())
 
 
+def _within(basin: torch.Tensor, values: torch.Tensor) -> torch.Tensor:
+    """B values, -inf outside the basin (B bool)."""
+    return torch.where(basin, values, torch.full_like(values, -math.inf))
+
+
 def pick_cue(score: torch.Tensor, contrast: torch.Tensor, coherence: torch.Tensor | None, pitches: torch.Tensor,
-          config: ShapeFitConfig, top: torch.Tensor | None = None, smooth: torch.Tensor | None = None,
-          relative: torch.Tensor | None = None) -> tuple[int, str]:
+             config: ShapeFitConfig, top: torch.Tensor | None = None, smooth: torch.Tensor | None = None,
+             relative: torch.Tensor | None = None) -> tuple[int, str]:
     """The cue that picks among candidates B (all within the outline's basin, and within config.cue_basin_px
     of the best top edge, `top`, where given):
     - painted bands, where their coherence peaks at least config.band_ratio x its lowest: they bound the lip's
@@ -89,19 +94,18 @@ def pick_cue(score: torch.Tensor, contrast: torch.Tensor, coherence: torch.Tenso
         basin = basin & (top <= top.min() + config.cue_basin_px)
     band = None
     if coherence is not None:
-        peaks = torch.where(basin, coherence, torch.full_like(coherence, -math.inf))
+        peaks = _within(basin, coherence)
         if float(peaks.max()) > config.band_ratio * max(float(coherence.min()), 1e-9):
             band = int(peaks.argmax())
             basin = basin & ((pitches - pitches[band]).abs() <= config.band_reach)
     tie = score if smooth is None else smooth
-    lips = torch.where(basin, contrast, torch.full_like(contrast, -math.inf))
+    lips = _within(basin, contrast)
     if float(lips.max()) > config.lip_contrast:
         return _lip_pick(lips, tie, config), "lip"
     if relative is not None and config.lip_relative is not None:
-        dark = torch.where(basin, relative, torch.full_like(relative, -math.inf))
-        if coherence is not None and config.dark_lip_bands is not None:
-            highest = torch.where(basin, coherence, torch.full_like(coherence, -math.inf)).max()
-            dark = torch.where(coherence >= config.dark_lip_bands * highest, dark, torch.full_like(dark, -math.inf))
+        dark = _within(basin, relative)
+        if coherence is not None and config.dark_lip_bands is not None:  # the bands rule out the pitches they fit worst
+            dark = _within(coherence >= config.dark_lip_bands * _within(basin, coherence).max(), dark)
         if float(dark.max()) > config.lip_relative:
             return _lip_pick(dark, tie, config), "dark_lip"
     if band is not None:
