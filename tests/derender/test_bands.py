@@ -20,12 +20,17 @@ CAMERA = CameraConfig()
 
 
 @functools.cache
-def _banded_vase():
-    """A dark vase at 2.7 deg painted with a meander band, flowers and a wavy line just under the rim (the
-    `radar synth --size 512 --seed 7` test sample 45)."""
-    files, params = make_sample(SynthConfig(size=512, seed=7), "test", 45, None)
+def synthetic_vase(seed: int, index: int) -> tuple[np.ndarray, np.ndarray, float]:
+    """(512 x 512 grey image, bool silhouette, true pitch) of the `radar synth --size 512 --seed SEED` test sample
+    INDEX."""
+    files, params = make_sample(SynthConfig(size=512, seed=seed), "test", index, None)
     grey = np.clip(files["image.png"], 0, 1).mean(axis=2).astype(np.float32)
     return grey, files["mask.png"] > 0.5, params["pose"][0]
+
+
+def _banded_vase():
+    """A dark vase at 2.7 deg painted with a meander band, flowers and a wavy line just under the rim."""
+    return synthetic_vase(7, 45)
 
 
 def _candidates(mask: np.ndarray, pitches: list[float]):

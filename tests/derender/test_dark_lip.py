@@ -5,25 +5,20 @@ silhouette alone cannot (at a low pitch a profile closing into a dome draws the 
 from __future__ import annotations
 
 import dataclasses
-import functools
 
 import numpy as np
 import torch
 
 from radar_cli.derender.refine.pitch_cues import pick_cue
 from radar_cli.derender.refine.shape_config import ShapeFitConfig
-from radar_cli.synth.generator import SynthConfig, make_sample
 
-from .test_bands import searched_pitch
+from .test_bands import searched_pitch, synthetic_vase
 
 
-@functools.cache
 def _dark_necked_vase() -> tuple[np.ndarray, np.ndarray, float]:
-    """(512 x 512 grey image, bool silhouette, true pitch 17.3 deg) of a vase with a dark brown neck ringed by
-    small olive squares, a black mouth, seen from above (the `radar synth --size 512 --seed 7` test sample 21)."""
-    files, params = make_sample(SynthConfig(size=512, seed=7), "test", 21, None)
-    grey = np.clip(files["image.png"], 0, 1).mean(axis=2).astype(np.float32)
-    return grey, files["mask.png"] > 0.5, params["pose"][0]
+    """(grey, silhouette, true pitch 17.3 deg) of a vase with a dark brown neck ringed by
+    small olive squares, a black mouth, seen from above."""
+    return synthetic_vase(7, 21)
 
 
 def test_a_dark_mouth_over_a_dark_neck_picks_the_steep_pitch():

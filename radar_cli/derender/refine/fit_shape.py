@@ -176,6 +176,41 @@ def _search(target: Outline, grey: torch.Tensor, size: int, pitches: torch.Tenso
             contrast / (level + config.lip_dark))
 
 
+def _second_look(target: Outline, size: int, shapes: tuple[torch.Tensor, torch.Tensor, torch.Tensor],
+                 scores: tuple[torch.Tensor, torch.Tensor, torch.Tensor], contrast: torch.Tensor,
+                 relative: torch.Tensor, config: ShapeFitConfig, camera: CameraConfig
+                 ) -> tuple[tuple[torch.Tensor, torch.Tensor, torch.Tensor], tuple[torch.Tensor, ...]]:
+    """The candidates outside the outline's basin whose lip is strong enough to pick (plain or relative), with
+    their profiles' widths corrected (correct_widths, config.lip_width_rounds) and scored again: seen steeply, a
+    bulging body's silhouette is wider than the discs under it (each row also shows the ellipses of the discs
+    above and below), so the closed-form profile of the true pitch is drawn too wide and left out of the basin
+    with the lip it shows. Level photographs keep their candidates: their steep ones show no strong lip.
+
+    Args:
+        shapes: (radius B x L, height B, pose B x 4) of the candidates; scores: (outline + bending B, top-edge
+            errors B, outline + uncapped bending B); contrast, relative: B lip contrasts (pick_cue).
+
+    Returns:
+        The shapes and scores with those candidates' entries replaced (new tensors).
+    """
+    score = scores[0]
+    strong = contrast > config.lip_contrast
+    if config.lip_relative is not None:
+        strong = strong | (relative > config.lip_relative)
+    redo = torch.nonzero(strong & (score > score.min() + config.basin)).flatten()
+    if not len(redo) or config.lip_width_rounds < 1:
+        return shapes, scores
+    radius, height, pose = shapes
+    better = correct_widths(target, size, radius[redo].clone(), height[redo], pose[redo], config.lip_width_rounds,
+                            camera, config.end_px * size / 256)
+    drawn = outline(Solid(better, height[redo], pose[redo]), size, camera)
+    fit = outline_score(drawn, target)
+    values = (fit + config.roughness_weight * roughness(better, config.corner), top_error(drawn, target),
+              fit + config.roughness_weight * roughness(better))
+    radius = radius.index_copy(0, redo, better)
+    return (radius, height, pose), tuple(t.index_copy(0, redo, v) for t, v in zip(scores, values))
+
+
 def search_pitch(target: Outline, grey: torch.Tensor, size: int, config: ShapeFitConfig, camera: CameraConfig,
                  prior_pitch: float | None = None,
                  bands: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[tuple[torch.Tensor, ...], str]:
@@ -190,6 +225,8 @@ def search_pitch(target: Outline, grey: torch.Tensor, size: int, config: ShapeFi
     coarse = torch.arange(0.0, config.pitch_max + 1e-6, config.coarse_step, dtype=torch.float64)
     shapes, score, contrast, top, smooth, relative = _search(target, grey, size, coarse, roll, tx, config, camera,
                                                              config.lip_offset_px)
+    shapes, (score, top, smooth) = _second_look(target, size, shapes, (score, top, smooth), contrast, relative,
+                                                config, camera)
     coherence = None if bands is None else band_coherence(bands[0], bands[1], *shapes, config.bands, camera)
     best, cue = pick_cue(score, contrast, coherence, coarse, config, top, smooth, relative)
     if cue == "outline" and prior_pitch is not None:

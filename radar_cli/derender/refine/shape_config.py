@@ -51,6 +51,8 @@ class ShapeFitConfig:
         lip_offset_px, fine_lip_offset_px: the lip's two sides are sampled this far above and below the arc (px
             at 512 px), on the coarse grid (wide: finds the lip) and on the fine one (narrow: places it).
         width_rounds: rounds of correct_widths at full resolution after the search.
+        lip_width_rounds: rounds of correct_widths for the search's candidates outside the basin that show a
+            strong lip, before they are scored again (fit_shape._second_look; 0: none).
         polish_steps: Adam steps at grid_size, then at full resolution, pitch held.
         polish_lr: their step (radii, height and offsets in hundredths of r_max, roll in degrees).
         placement_iterations: closed-form rounds of profile, height and vertical offset per candidate.
@@ -78,6 +80,7 @@ class ShapeFitConfig:
     lip_offset_px: float = 2.0
     fine_lip_offset_px: float = 1.0
     width_rounds: int = 3
+    lip_width_rounds: int = 1
     polish_steps: tuple[int, int] = (40, 10)
     polish_lr: float = 0.05
     placement_iterations: int = 3

@@ -1,0 +1,28 @@
+"""A steep vase with a bulging body and a visible lip: at its true pitch the closed-form profile is drawn too wide
+(each row of a steep view also shows the ellipses of the discs above and below), which left that candidate out of
+the outline's basin with its lip; the candidates with a strong lip are scored again with their widths corrected."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from radar_cli.derender.refine.shape_config import ShapeFitConfig
+
+from .test_bands import searched_pitch, synthetic_vase
+
+
+def _bulging_vase() -> tuple[np.ndarray, np.ndarray, float]:
+    """(grey, silhouette, true pitch 18.1 deg) of a squat violet vase with a wide shoulder,
+    its black mouth seen over a pale lip."""
+    return synthetic_vase(17, 24)
+
+
+def test_a_strong_lip_outside_the_basin_is_looked_at_again():
+    grey, mask, truth = _bulging_vase()
+    assert truth > 15.0
+    pitch, cue = searched_pitch(grey, mask, ShapeFitConfig())
+    assert cue == "lip" and abs(pitch - truth) <= 1.0, (pitch, cue, truth)
+    level, cue = searched_pitch(grey, mask, dataclasses.replace(ShapeFitConfig(), lip_width_rounds=0))
+    assert truth - level > 10.0, (level, cue)  # without the second look the silhouette reads it level
