@@ -86,7 +86,7 @@ def silhouette_iou(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tenso
     """IoU of the ray-cast silhouette (N x N, hard) with an N x N bool mask."""
     with torch.no_grad():
         drawn = cast_rays(Solid(radius.float(), height.float(), pose.float()), mask.shape[0], camera, 1.0,
-                          soft_outside=False).mask[0].numpy()
+                          soft_outside=False).mask[0].cpu().numpy()
     return iou(drawn, mask)
 
 
@@ -98,7 +98,8 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
 
     Args:
         model: the RadarModel (its read_appearance re-reads lighting, material and albedo at a shape).
-        image: 1 x 3 x S x S network input in [0, 1]. dec: its Decomposition (batch of one, CPU).
+        image: 1 x 3 x S x S network input in [0, 1], on the model's device. dec: its Decomposition (batch of
+            one, CPU: the fits run there).
         crop: N x N x 3 uint8 crop at the output resolution; silhouette: N x N bool located silhouette (None:
             nothing to fit, the network's prediction is kept).
         camera: the fixed camera. config, light: the shape and the lighting fits' settings (light None: no
@@ -141,16 +142,17 @@ def read_at_shape(model, image: torch.Tensor, dec: Decomposition, geo: Solid, cr
                   report: RefineReport) -> tuple[Decomposition, RefineReport]:
     """The appearance at a fitted shape: lighting, material and albedo re-read there by the networks, the specular
     albedo by `reader` (None: f_L's, at most 1), the environment map fitted to the crop's shading (light None:
-    the re-reading kept). geo: the fitted solid (radius 1 x L, height 1, pose 1 x 4); the rest as refine_object."""
+    the re-reading kept). geo: the fitted solid (radius 1 x L, height 1, pose 1 x 4); the rest as refine_object.
+    The networks run on `image`'s device; the result is on the CPU."""
     device = image.device
     with torch.no_grad():
         solid = geo.map(lambda t: t.to(device))
         refined = model.read_appearance(image, solid).detach()
         rho = refined.rho.clamp(max=MAX_SPECULAR_ALBEDO) if reader is None else reader(image, solid)
-    refined = dataclasses.replace(refined, rho=rho)
+    refined = dataclasses.replace(refined, rho=rho).to("cpu")
     report = dataclasses.replace(report, specular="network" if reader is None else "reader")
     if light is not None:
-        refined, report = _fit_light(refined, dec.env, crop, silhouette, camera, light, report)
+        refined, report = _fit_light(refined, dec.env.cpu(), crop, silhouette, camera, light, report)
     return refined, report
 
 

@@ -193,8 +193,9 @@ class Predictor:
             return dec, RefineReport("off", "the output is at the network's size", crop.shape[0])
         batch = torch.from_numpy(image).permute(2, 0, 1)[None].to(self.device, torch.float32) / 255.0
         light = LightFitConfig() if self.refine == "full" else None
-        refined, report = refine_object(self.model, batch, dec.to(self.device), crop, silhouette,
-                                        self.setup.camera, light=light, reader=self.reader)
+        # the fits run on the CPU (float64 outlines, small steps); only the networks' re-reading runs on the device
+        refined, report = refine_object(self.model, batch, dec, crop, silhouette, self.setup.camera, light=light,
+                                        reader=self.reader)
         return (dec if refined is None else refined.to("cpu")), report
 
 
