@@ -207,7 +207,7 @@ def top_dome(core: np.ndarray, neck: float = 0.8, reach: float = 0.7) -> float |
     width below it), the rows from the top down to the first one `reach` of the widest row above the neck,
     over that widest row's width; the largest. An open mouth's rim seen from the side or a little from above
     is an ellipse cut level: about 0.14 sin(pitch), under 0.09 on the vessels measured; a head, a stopper or a
-    hemispherical knob rounds over a height like its width: 0.18-0.9 on the generated lids. 0 without a neck.
+    hemispherical knob rounds over a height like its width: 0.18-0.80 on the generated lids. 0 without a neck.
 
     Args:
         core: H x W bool symmetric core of the located object (its appendages left out). None if empty.
