@@ -39,6 +39,8 @@ def test_a_good_result_is_ok() -> None:
     ({"neighbour_cut": True}, "review", "neighbouring object was cut away"),
     ({"base_off_axis": 0.3}, "review", "another object probably merged"),
     ({"foot_asymmetry": 0.05}, "review", "not a foot's level arc"),
+    ({"edge_roughness": 0.002}, "review", "lower outline is jagged"),
+    ({"top_dome": 0.25}, "review", "dome above a neck"),
     ({"silhouette_iou": None, "symmetry": None, "silhouette_area": None}, "review", "no silhouette"),
 ])
 def test_each_score_can_demote(change: dict, status: str, words: str) -> None:
@@ -161,8 +163,30 @@ def test_a_vase_broken_off_along_a_jagged_line_is_not_ok() -> None:
     photo_broken = np.where(piece[..., None], photo, 255).astype(np.uint8)
     status, reasons = _judged(photo_broken, core, core, photo_broken, piece & ~core)
     assert status == "review" and any("not a foot's level arc" in r for r in reasons), reasons
+    assert any("lower outline is jagged" in r for r in reasons), reasons
     wider_foot = sil | (np.roll(sil, 2, 1) | np.roll(sil, -2, 1)) & (rows > ys[-1] - 0.1 * np.ptp(ys))
     assert _judged(photo, sil, wider_foot, photo) == ("ok", [])
+
+
+def test_a_vase_under_a_head_shaped_lid_is_not_ok() -> None:
+    """A rendered vase with a head on a neck above its mouth, painted in one colour, its nose inside the outline
+    (as experiments.status_cases draws it, the nose left out): the core stays symmetric and the solid follows
+    it, so only the closed top tells a head from a mouth."""
+    import cv2
+
+    photo, sil = _vase_on_white()
+    body = np.concatenate([np.zeros((128, 256), bool), sil])  # room above the mouth for the head
+    photo = np.concatenate([np.full((128, 256, 3), 255, np.uint8), photo])
+    ys, xs = np.nonzero(body)
+    cx, half = int(xs[ys == ys[0]].mean()), int(0.25 * np.ptp(xs))
+    head = np.zeros(body.shape, np.uint8)
+    cv2.rectangle(head, (cx - half // 2, ys[0] - half), (cx + half // 2, ys[0] + 2), 1, -1)
+    cv2.ellipse(head, (cx, ys[0] - int(0.8 * 1.25 * half)), (half, int(1.25 * half)), 0, 0, 360, 1, -1)
+    lidded = body | (head > 0)
+    shade = np.clip(1.0 - 0.5 * np.abs(np.arange(256) - cx) / half, 0.5, 1.0)[None, :, None]
+    photo = np.where((head > 0)[..., None], np.array([60, 90, 200]) * shade, photo).astype(np.uint8)
+    status, reasons = _judged(photo, lidded, lidded, photo)
+    assert status == "review" and any("dome above a neck" in r for r in reasons), reasons
 
 
 def test_invented_highlights_are_flagged() -> None:

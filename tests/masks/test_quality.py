@@ -1,12 +1,12 @@
 """The whole-object scores of masks.quality: how far a solid's outline is off a silhouette, how round a
-silhouette is, how uneven its lower outline is."""
+silhouette is, how uneven or jagged its lower outline is, whether its top closes in a dome."""
 
 from __future__ import annotations
 
 import cv2
 import numpy as np
 
-from radar_cli.masks.quality import foot_asymmetry, outline_residual, roundness
+from radar_cli.masks.quality import edge_roughness, foot_asymmetry, outline_residual, roundness, top_dome
 
 
 def _box(shift: int = 0) -> np.ndarray:
@@ -66,3 +66,43 @@ def test_a_broken_lower_edge_is_not_a_foot() -> None:
         walk -= np.interp(cols, [0, 199], [walk[0], walk[-1]])
         jagged.append(_broken(110 + 12 * walk / np.abs(walk).max()))
     assert min(jagged) > 0.02 and sum(v > 0.03 for v in jagged) >= 3, jagged
+
+
+def test_a_jagged_break_is_rough_where_a_foot_is_smooth() -> None:
+    """The random-walk breaks above, nearly level or as uneven on both sides as a foot (where foot_asymmetry
+    stays under its limit), are all rough; a foot's arc is smooth whether or not the solid follows it."""
+    assert edge_roughness(_vase(), _vase()) == 0.0
+    assert edge_roughness(_vase(36), _vase(26)) == 0.0
+    cols, rows = np.arange(200), np.arange(200)[:, None]
+    for seed in range(8):
+        walk = np.cumsum(np.random.default_rng(seed).normal(0, 1, 200))
+        walk -= np.interp(cols, [0, 199], [walk[0], walk[-1]])
+        piece = _vase() & (rows <= (110 + 12 * walk / np.abs(walk).max())[None])
+        assert edge_roughness(piece, _vase() & (rows <= 98)) > 0.004, seed
+    assert edge_roughness(np.zeros((10, 10), bool), _vase()) is None
+
+
+def _flask(top: str, size: float) -> np.ndarray:
+    """A flask: a bellied body, a neck of half-width 12 and on top either an open mouth's lip (half-width 26, its
+    rim an ellipse seen `size` deg from the side) or a head (an ellipse of half-width 22, `size` x that tall)."""
+    mask = np.zeros((240, 200), np.uint8)
+    for y in range(110, 231):
+        half = int(20 + 50 * np.sin(np.pi * (y - 100) / 140))
+        mask[y, 100 - half:100 + half + 1] = 1
+    cv2.rectangle(mask, (88, 60), (112, 112), 1, -1)
+    if top == "mouth":
+        cv2.rectangle(mask, (74, 50), (126, 60), 1, -1)
+        cv2.ellipse(mask, (100, 50), (26, max(1, round(26 * np.sin(np.radians(size))))), 0, 0, 360, 1, -1)
+    else:
+        cv2.ellipse(mask, (100, 64 - round(22 * size)), (22, round(22 * size)), 0, 0, 360, 1, -1)
+    return mask > 0
+
+
+def test_a_head_on_a_neck_is_a_dome_and_an_open_mouth_is_not() -> None:
+    """An open mouth seen from the side up to 45 deg from above reads about 0.14 sin(pitch); a head as tall as
+    the generated lids' (1.25 x its half-width) 0.18, a flatter knob less."""
+    mouths = [top_dome(_flask("mouth", pitch)) for pitch in (0, 10, 20, 30, 45)]
+    assert mouths[0] == 0.0 and max(mouths) < 0.12, mouths
+    assert top_dome(_flask("head", 1.25)) > 0.16
+    assert top_dome(_flask("head", 0.6)) < 0.1
+    assert top_dome(_vase()) == 0.0  # no neck: the widest rows are the body's

@@ -21,7 +21,14 @@ from radar_cli.derender.run.inputs import Prepared
 from radar_cli.derender.run.state import ObjectState
 from radar_cli.masks.crop import outside_mask
 from radar_cli.masks.outline import outline_support
-from radar_cli.masks.quality import foot_asymmetry, outline_residual, roundness, sor_score
+from radar_cli.masks.quality import (
+    edge_roughness,
+    foot_asymmetry,
+    outline_residual,
+    roundness,
+    sor_score,
+    top_dome,
+)
 from radar_cli.masks.refine import iou
 
 STATUSES = ("failed", "review", "ok")  # worst first: the order a curator reads them in
@@ -59,6 +66,12 @@ class QualityLimits:
     review_foot: float = 0.03
     """The object's lower outline further than this share of its height from mirror-symmetric about the solid's
     axis (`foot_asymmetry`): review (a broken edge or a sherd, not a foot)."""
+    review_roughness: float = 0.0008
+    """The object's lower outline departing from its running median by more than this share of its height
+    (`edge_roughness`): review (a jagged break, not a foot)."""
+    review_dome: float = 0.13
+    """The object's top closing in a dome above a neck over more than this share of the dome's width
+    (`top_dome`): review (a head, a stopper or a knob on a lid, not a mouth)."""
     review_roundness: float = 0.9
     """The object's silhouette this close to a filled ellipse or closer, with a lit rim round a dark inside
     (`review_rim`): review (a view into the mouth from above, not a side view)."""
@@ -140,6 +153,8 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
         "object_symmetry": None if whole is None else _round(sor_score(whole)),
         "outline_residual": None if sil is None else _round(outline_residual(sil, rendered)),
         "foot_asymmetry": None if whole is None else _round(foot_asymmetry(whole, rendered)),
+        "edge_roughness": None if whole is None else _round(edge_roughness(whole, rendered), 5),
+        "top_dome": None if sil is None else _round(top_dome(sil)),
         "roundness": None if whole is None else _round(roundness(whole)),
         "recon_psnr": _round(psnr(recon[region], photo[region]), 2) if region.any() else None,
         "mouth_error": _round(mouth_error(photo, recon, region & rendered, mouth)),
@@ -200,6 +215,11 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
         ("foot_asymmetry", lambda v: v > limits.review_foot,
          "the lower outline is uneven, not a foot's level arc ({:.1%} of the height off its mirror image): a "
          "broken edge or a sherd?"),
+        ("edge_roughness", lambda v: v > limits.review_roughness,
+         "the lower outline is jagged ({:.2%} of the height off its smooth course), not a foot's arc: a break?"),
+        ("top_dome", lambda v: v > limits.review_dome,
+         "the top closes in a dome above a neck ({:.2f} of its width deep), not an open mouth: a head, a stopper "
+         "or a lid's knob - is it turned?"),
         ("roundness", lambda v: v >= limits.review_roundness and (record.get("rim_contrast") or 0) >= limits.review_rim,
          "the silhouette is round ({:.2f}), a lit rim round a dark inside: a view from above into the mouth, "
          "not a side view?"),
