@@ -24,6 +24,8 @@ from radar_cli.harvest.dimensions import size_of_record
 from radar_cli.sizes import ObjectSize
 
 CATALOG_NAME = "catalog.sqlite"
+OBJECTS_DIR = "met"
+"""The folder under a harvest's --out that holds the photos: <id>.<ext>, or <id>/ with every view."""
 STATES = ("searched", "record", "image", "skipped", "failed")
 LICENCE_PD = "CC0-1.0"
 LICENCE_OTHER = "not public domain"

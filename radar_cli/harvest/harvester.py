@@ -26,14 +26,13 @@ from tqdm import tqdm
 
 from radar_cli.errors import InputError, NetworkError
 from radar_cli.fileio import remove_stale_temps, write_bytes, write_text
-from radar_cli.harvest.catalog import CATALOG_NAME, Catalog, open_catalog
+from radar_cli.harvest.catalog import CATALOG_NAME, OBJECTS_DIR, Catalog, open_catalog
 from radar_cli.harvest.client import ClientConfig, FetchError, HttpClient
 from radar_cli.harvest.dimensions import size_of_record
 from radar_cli.harvest.images import MAX_PIXELS, download_image
 from radar_cli.harvest.met_api import DEFAULT_API_URL, MetApi
 from radar_cli.harvest.views import ViewStage, read_stored_record
 
-OBJECTS_DIR = "met"
 LOCK_FILE = ".fetch.lock"
 MAX_CONSECUTIVE_FAILURES = 20  # an outage: stop instead of marking every remaining object failed
 

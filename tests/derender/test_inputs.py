@@ -108,3 +108,20 @@ def test_white_backdrop_through_the_silhouette(tmp_path: Path) -> None:
         assert prepared.silhouette is not None and prepared.silhouette.shape == (SIZE, SIZE)
         assert prepared.silhouette[centre].all() and not prepared.silhouette[1, 1]
     assert prepare(item, SIZE, crop="none").silhouette is None  # nothing located, nothing known
+
+
+def test_a_fetch_folder_gives_one_object_per_record(tmp_path: Path) -> None:
+    """`radar fetch --out data` keeps one-photo objects as data/met/<id>.jpg and several-photo ones as
+    data/met/<id>/: `radar derender data` makes one object of each, not one of the whole `met` folder."""
+    (tmp_path / "data" / "met").mkdir(parents=True)
+    (tmp_path / "data" / "catalog.sqlite").write_bytes(b"")
+    for stem in ("101", "102"):
+        write_photo(tmp_path / "data" / "met" / f"{stem}.jpg", int(stem))
+    for view in range(3):
+        write_photo(tmp_path / "data" / "met" / "103" / f"103_{view}.jpg", view)
+    (tmp_path / "data" / "met" / "101.json").write_text("{}")  # the stored record: not an image
+    items, failures = collect_inputs([tmp_path / "data"])
+    assert not failures
+    assert [(i.name, len(i.views)) for i in items] == [("101", 0), ("102", 0), ("103", 3)]
+    plain, _ = collect_inputs([tmp_path / "data" / "met"])  # the photos' folder itself: the same objects
+    assert [(i.name, len(i.views)) for i in plain] == [("101", 0), ("102", 0), ("103", 3)]

@@ -14,6 +14,7 @@ import numpy as np
 from radar_cli.dataset import IMAGE_FILE, MASK_FILE, is_dataset, safe_id
 from radar_cli.errors import InputError
 from radar_cli.fileio import read_image
+from radar_cli.harvest.catalog import CATALOG_NAME, OBJECTS_DIR
 from radar_cli.masks.crop import CropBox, cut, mask_box, square_box
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".webp", ".tif", ".tiff")
@@ -138,7 +139,7 @@ def _is_image(path: Path) -> bool:
 
 def _folder_items(folder: Path, masks: Path | None) -> list[InputItem]:
     """Items (names not yet unique) of a folder: a prepared dataset (<split>/<id>/image.png), one split of it
-    (<id>/image.png), or else every image under it.
+    (<id>/image.png), a `radar fetch` folder (its photos, under OBJECTS_DIR), or else every image under it.
 
     Dataset samples are named by id, so `radar eval` matches them to their ground truth; with several splits
     the split is prefixed (<split>_<id>)."""
@@ -150,6 +151,8 @@ def _folder_items(folder: Path, masks: Path | None) -> list[InputItem]:
     samples = sorted(folder.glob(f"*/{IMAGE_FILE}"))
     if samples:
         return [InputItem(p.parent.name, p, _existing(p.parent / MASK_FILE), is_crop=True) for p in samples]
+    if (folder / CATALOG_NAME).is_file() and (folder / OBJECTS_DIR).is_dir():  # a `radar fetch` folder
+        folder = folder / OBJECTS_DIR  # its photos: <id>.jpg one view each, <id>/ every view of one object
     images = sorted(p for p in folder.rglob("*") if p.is_file() and _is_image(p))
     by_folder: dict[Path, list[Path]] = {}
     for p in images:
