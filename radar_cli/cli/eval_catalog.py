@@ -12,7 +12,8 @@ from radar_cli.fileio import write_json
 @click.command("eval-catalog")
 @click.argument("results", type=click.Path(file_okay=False))
 @click.option("--dimensions", required=True, type=click.Path(dir_okay=False),
-              help="Catalogue table (tab-separated: object, height_cm, rim_cm, body_cm, foot_cm).")
+              help="Catalogue table, TSV or CSV: an object, object_id or id column, height_cm, optional rim_cm, "
+                   "body_cm, foot_cm.")
 @click.option("--drawings", type=click.Path(file_okay=False), default=None,
               help="Folder of digitised profiles <object>.csv (height_cm,radius_cm from the foot up).")
 @click.option("--silhouettes", type=click.Path(file_okay=False), default=None,
