@@ -1,6 +1,7 @@
-// radar gallery: the overview (search, status filter, sort by any score, pages of thumbnails) and one object's
-// detail view (3D mesh in <model-viewer>, relit under its own recovered lighting or a built-in environment).
-// Data comes from data.js (window.RADAR_GALLERY, written by radar_cli/derender/gallery.py). Text from the
+// radar gallery: the overview (search, status filter, sort by status, id, title, the scores in DATA.scores or the
+// material, pages of thumbnails) and one object's detail view (3D mesh in <model-viewer>, relit under its own
+// recovered lighting or a built-in environment).
+// Data comes from data.js (window.RADAR_GALLERY, written by radar_cli/derender/present/gallery.py). Text from the
 // results is only ever set as textContent, never parsed as HTML.
 "use strict";
 (function () {
