@@ -235,7 +235,7 @@ def test_an_object_with_several_views_is_one_card_with_its_views(browser, multiv
     wait_for_thumbnails(page)
     keep(page.screenshot(), "gallery-multiview-overview.png")
     assert sorted(page.eval_on_selector_all(".card", "cards => cards.map(c => c.dataset.id)")) == ["pot", "single"]
-    assert page.locator(".card[data-id='single'] .views").count() == 0  # one photo: the card as before
+    assert page.locator(".card[data-id='single'] .views").count() == 0  # one photo: a plain card, no strip
     captions = page.eval_on_selector_all(".card[data-id='pot'] .views figcaption", "fs => fs.map(f => f.textContent)")
     assert captions[0] == "front0°" and "brokenleft out" in captions and len(captions) == 4  # name, turn
     assert page.locator(".card[data-id='pot'] .views img").count() == 3  # the unreadable photo has no picture

@@ -94,7 +94,7 @@ def test_fused_texture_matches_on_every_side_and_the_mirrored_one_does_not(synth
     assert fused.seen_fraction() > 0.95
     fused_errors = side_errors(fused.albedo, albedo)
     assert max(fused_errors) < 0.05, fused_errors
-    single = full_from_front(front_third(views[0].albedo))  # today's single view: the front mirrored round
+    single = full_from_front(front_third(views[0].albedo))  # a single view's albedo: the front mirrored round
     single_errors = side_errors(single, albedo)
     assert single_errors[0] > 3 * max(fused_errors), (single_errors, fused_errors)  # the back is the front mirrored
     assert single_errors[0] > 0.08

@@ -1,7 +1,7 @@
 """An object photographed from several sides in the results: a picture per view (views/<photo>.png: the crop
 beside the object drawn as that view sees it, with the fused albedo), named from the photo safely, recorded in
 material.json and listed by the gallery's data; its mesh carries the fused texture; a single photo's object is
-listed as before."""
+listed without views or coverage."""
 
 from __future__ import annotations
 
@@ -125,7 +125,7 @@ def test_the_mesh_carries_the_fused_texture(results: Path) -> None:
     assert mirror_difference(glb_texture(results / "pot" / "mesh.glb")) > 10.0  # the back from the other views
 
 
-def test_the_gallery_lists_the_views_and_single_objects_stay_as_before(results: Path) -> None:
+def test_the_gallery_lists_the_views_and_single_objects_without_them(results: Path) -> None:
     write_report(results, [])
     objects = {o["id"]: o for o in gallery_data(results)["objects"]}
     assert objects["single"]["views"] == [] and not objects["single"]["coverage"]
