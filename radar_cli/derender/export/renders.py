@@ -15,6 +15,7 @@ from PIL import Image
 from radar_cli.config import CameraConfig
 from radar_cli.derender.export.environments import match_exposure
 from radar_cli.derender.export.maps import FAST_ENCODE_PIXELS, chw_image, write_picture
+from radar_cli.derender.export.palette import quantize
 from radar_cli.derender.run.state import ObjectState
 from radar_cli.fileio import atomic_path, to_uint8
 from radar_cli.render.lighting import compose, tone_map
@@ -161,14 +162,19 @@ def material_sphere(state: ObjectState, size: int) -> np.ndarray:
 
 
 def gif_frames(views: list[np.ndarray]) -> list[Image.Image]:
-    """GIF frames of H x W x 3 uint8 views: large ones (FAST_ENCODE_PIXELS) share one palette, made once by median
-    cut over all of them (cheaper than Pillow's per-frame palettes, truer than its fast octree: docs/resolution.md);
-    smaller ones are left to Pillow's per-frame palettes."""
+    """GIF frames of H x W x 3 uint8 views: large ones (FAST_ENCODE_PIXELS) share one palette, a median cut of a
+    sample of all of them, each pixel drawn by its nearest entry (export.palette: cheaper and truer than Pillow's
+    per-frame palettes and than its median cut of every pixel, docs/resolution.md); smaller ones are left to
+    Pillow's per-frame palettes."""
     if views[0].shape[0] * views[0].shape[1] < FAST_ENCODE_PIXELS:
         return [Image.fromarray(v) for v in views]
-    height, width = views[0].shape[:2]
-    strip = Image.fromarray(np.concatenate(views, axis=1)).quantize(256, method=Image.Quantize.MEDIANCUT)
-    return [strip.crop((k * width, 0, (k + 1) * width, height)) for k in range(len(views))]
+    indices, palette = quantize(views)
+    frames = []
+    for index in indices:
+        frame = Image.frombytes("P", (index.shape[1], index.shape[0]), np.ascontiguousarray(index).tobytes())
+        frame.putpalette(palette.tobytes())
+        frames.append(frame)
+    return frames
 
 
 def write_turntable(folder: Path, view: ViewRenderer, frames: int) -> None:
