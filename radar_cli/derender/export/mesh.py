@@ -22,6 +22,8 @@ from radar_cli.sor.mesh import triangulate
 # canonical frame (seen side at -z) -> export frame (seen side at +z): a proper rotation, so winding is kept
 TO_VIEWER_FRONT = np.array([-1.0, 1.0, -1.0])
 MAX_SPECULAR_FACTOR = 1.0  # MTL Ks lies in [0, 1]; rho (0..2) is halved and clipped for it
+OBJ_MTL = "mesh.mtl"
+OBJ_HEADER = "https://github.com/mikedh/trimesh"  # the meshes' geometry and materials are trimesh's
 TEXTURE_PNG = {"compress_level": 1}
 """How trimesh's PNG of the texture (in mesh.glb and beside mesh.obj) is encoded: zlib level 1 took 0.04 CPU s for
 a 1,536 x 512 albedo where Pillow's default took 0.17 s, twice per object; the pixels are the same."""
@@ -69,19 +71,33 @@ def write_meshes(folder: Path, state: ObjectState, n_cols: int, height_cm: float
     assert isinstance(glb, bytes)  # a binary format
     write_bytes(folder / MESH_GLB_FILE, glb)
     material: Any = mesh.visual.material  # type: ignore[union-attr]  # build_mesh's TextureVisuals and PBRMaterial
-    obj_mesh = mesh.copy()
     # OBJ/MTL is Phong: white Kd so viewers show the texture as is, Ns = shininess, Ks from the specular albedo
     spec = int(round(255 * min(float(state.material.rho[0]) / 2.0, MAX_SPECULAR_FACTOR)))
-    obj_mesh.visual.material = trimesh.visual.material.SimpleMaterial(  # type: ignore[union-attr]
+    phong = trimesh.visual.material.SimpleMaterial(
         name="albedo", image=material.baseColorTexture, diffuse=(255, 255, 255, 255),
         ambient=(255, 255, 255, 255), specular=(spec, spec, spec, 255), glossiness=float(state.material.alpha[0]))
-    obj_mesh.visual.material.image.encoderinfo = dict(TEXTURE_PNG)  # type: ignore[union-attr]
-    text, files = trimesh.exchange.obj.export_obj(obj_mesh, include_texture=True, return_texture=True,
-                                                  mtl_name="mesh.mtl")
-    for name, data in files.items():
-        if Path(name).name != name:  # trimesh names these; never write outside the folder
-            raise OSError(f"unexpected texture file name from the OBJ exporter: {name!r}")
-        write_bytes(folder / name, data)
-    write_bytes(folder / MESH_OBJ_FILE, text.encode("utf-8"))
+    phong.image.encoderinfo = dict(TEXTURE_PNG)
+    files, name = phong.to_obj(name="albedo")  # {albedo.png, albedo.mtl}: the texture and its Phong material
+    mtl = files.pop(f"{name}.mtl")
+    files[OBJ_MTL] = f"# {OBJ_HEADER}\n\n".encode() + mtl
+    for file_name, data in files.items():
+        if Path(file_name).name != file_name:  # trimesh names these; never write outside the folder
+            raise OSError(f"unexpected texture file name from the OBJ exporter: {file_name!r}")
+        write_bytes(folder / file_name, data)
+    write_bytes(folder / MESH_OBJ_FILE, obj_text(mesh.vertices, mesh.visual.uv, mesh.faces, name))  # type: ignore[union-attr]
     return real
 
+
+def _lines(line: str, values: np.ndarray) -> str:
+    """One `line` (%-style, one field per column) per row of an M x C array, joined by newlines."""
+    return "\n".join([line] * len(values)) % tuple(values.ravel().tolist())
+
+
+def obj_text(vertices: np.ndarray, uv: np.ndarray, faces: np.ndarray, material: str) -> bytes:
+    """mesh.obj's text: V x 3 positions, V x 2 texture coordinates and F x 3 vertex indices (0-based), each
+    vertex's uv under its own index, the material `material` from OBJ_MTL. The lines trimesh's OBJ exporter
+    writes (8 decimals), formatted from Python floats at a fraction of its cost (docs/performance.md)."""
+    corners = np.repeat(faces.astype(np.int64) + 1, 2, axis=1)  # F x 6: v/vt pairs
+    parts = [f"# {OBJ_HEADER}", f"mtllib {OBJ_MTL}", f"usemtl {material}", _lines("v %.8f %.8f %.8f", vertices),
+             _lines("vt %.8f %.8f", uv), _lines("f %d/%d %d/%d %d/%d", corners), "\n"]
+    return "\n".join(parts).encode("utf-8")
