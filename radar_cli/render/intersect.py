@@ -99,22 +99,23 @@ def _first(values: torch.Tensor, ray_idx: torch.Tensor, m: int) -> torch.Tensor:
 @torch.no_grad()
 def search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_idx: torch.Tensor,
            h: torch.Tensor, s_near: torch.Tensor, s_far: torch.Tensor, deep: float = float("inf"),
-           misses: bool = True) -> Found:
+           misses: bool = True, hits_only: bool = False) -> Found:
     """Exact first hits, mouth exits and minimisers of F = max(rho - r(y), |y| - h) along M rays, SEARCH_CHUNK
     rays at a time (see _search for the arguments)."""
     m = origin.shape[0]
     if m <= SEARCH_CHUNK:
-        return _search(origin, direction, rows, b_idx, h, s_near, s_far, deep, misses)
+        return _search(origin, direction, rows, b_idx, h, s_near, s_far, deep, misses, hits_only)
     parts = []
     for i in range(0, m, SEARCH_CHUNK):
         part = slice(i, i + SEARCH_CHUNK)
         parts.append(_search(origin[part], direction[part], rows, b_idx[part], h[part], s_near[part], s_far[part],
-                             deep, misses))
+                             deep, misses, hits_only))
     return Found(*(torch.cat([getattr(f, name) for f in parts]) for name in ("s_min", "s_hit", "hit", "inner", "cap")))
 
 
 def _search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b_idx: torch.Tensor,
-            h: torch.Tensor, s_near: torch.Tensor, s_far: torch.Tensor, deep: float, misses: bool) -> Found:
+            h: torch.Tensor, s_near: torch.Tensor, s_far: torch.Tensor, deep: float, misses: bool,
+            hits_only: bool = False) -> Found:
     """Exact first hits, mouth exits and minimisers of F = max(rho - r(y), |y| - h) along M rays.
 
     Args:
@@ -127,6 +128,8 @@ def _search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b
             (their soft silhouette is saturated): s_min is that middle point instead.
         misses: minimise F along the rays that miss too (for their soft silhouette); False skips them, for a
             caller that only needs the hits (their s_min is then the closest approach to the object's centre).
+        hits_only: stop after the hits (hit, inner, cap and s_hit as always; s_min is then the middle of the first
+            chord through the solid, or the entry): for a caller that needs the hard silhouette alone.
 
     Returns:
         Found (all M).
@@ -152,6 +155,8 @@ def _search(origin: torch.Tensor, direction: torch.Tensor, rows: torch.Tensor, b
     t_lo, t_hi = torch.minimum(t_lo, t_hi), torch.maximum(t_lo, t_hi)
 
     hits = _hits(ray, pair, ray_idx, alpha, beta, t_lo, t_hi, flat, b_idx, h, n_rows, -s_c)
+    if hits_only:
+        return Found(hits.s_min + s_c, hits.s_hit + s_c, hits.hit, hits.inner, hits.cap)
     mid = hits.s_min
     inside = hits.hit & (_implicit(ray, mid[:, None], h, flat, b_idx, n_rows)[:, 0] < -deep)
     skip = inside if misses else inside | ~hits.hit  # rays whose s_min is not minimised

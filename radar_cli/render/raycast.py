@@ -128,25 +128,13 @@ def cast_rays(
     Returns:
         Hits with H = W = size.
     """
-    radius, height, pose = solid.radius, solid.height, solid.pose
-    check_sor(radius, height, pose)
-    if not (isinstance(size, int) and size >= 1) or not (math.isfinite(sigma_px) and sigma_px > 0):
-        raise InputError(f"size must be >= 1 and sigma_px > 0, got size={size}, sigma_px={sigma_px}")
+    radius, height = solid.radius, solid.height
     n_batch, dev, dt = radius.shape[0], radius.device, radius.dtype
-    sigma = sigma_px * pixel_size(size, camera)
-    rot, origin, dirs, d_obj = object_rays(pose, size, camera)
-    r_world, h_world = radius * camera.r_max, height * camera.r_max
-
-    cull = (CULL_SIGMAS if soft_outside else HIT_SIGMAS) * sigma  # bounding-cylinder margin: the soft halo or none
-    s_near, s_far = _span(origin.detach(), d_obj.detach(), r_world.detach().amax(1) + cull, h_world.detach() + cull)
-    active = s_far > s_near  # B x P
-    b_idx, p_idx = active.nonzero(as_tuple=True)
-    flat = b_idx * d_obj.shape[1] + p_idx
-    rays = _Rays(b_idx, origin.index_select(0, b_idx), d_obj.reshape(-1, 3).index_select(0, flat), r_world,
-                 h_world.index_select(0, b_idx))
-
-    found = search(rays.o.detach(), rays.d.detach(), r_world.detach(), b_idx, rays.h.detach(),
-                   s_near[b_idx, p_idx], s_far[b_idx, p_idx], deep=DEEP_SIGMAS * sigma, misses=soft_outside)
+    sigma = _check(solid, size, camera, sigma_px)
+    rot, dirs, d_obj, rays, flat, p_idx, span = _active_rays(solid, size, camera, sigma, soft_outside)
+    r_world = radius * camera.r_max
+    found = search(rays.o.detach(), rays.d.detach(), r_world.detach(), rays.b, rays.h.detach(), *span,
+                   deep=DEEP_SIGMAS * sigma, misses=soft_outside)
     g = _margin(rays, found.s_min)  # differentiable margin, world units
     # g is close to the distance from the ray to the solid, ~ pixels * pixel size at the object; the taper
     # takes the soft silhouette to exactly 0 at the culling margin, so it stays continuous in every input
@@ -173,6 +161,46 @@ def cast_rays(
     normal = normal.view(n_batch, size, size, 3)
     uv_img = scatter(uv).view(n_batch, size, size, 2)
     return Hits(sil, mask, inner, depth, points, normal, uv_img)
+
+
+def hit_mask(solid: Solid, size: int, camera: CameraConfig = CameraConfig()) -> torch.Tensor:
+    """The hard silhouette alone, no grad: cast_rays(solid, size, camera, 1.0, soft_outside=False).mask, the same
+    rays searched only as far as their first hits (about half the cost). B x size x size bool."""
+    sigma = _check(solid, size, camera, 1.0)
+    with torch.no_grad():
+        _, _, d_obj, rays, flat, _, span = _active_rays(solid, size, camera, sigma, False)
+        found = search(rays.o, rays.d, solid.radius * camera.r_max, rays.b, rays.h, *span, hits_only=True)
+        total = solid.radius.shape[0] * d_obj.shape[1]
+        mask = torch.zeros(total, dtype=torch.bool, device=solid.radius.device).index_put((flat,), found.hit)
+    return mask.view(-1, size, size)
+
+
+def _check(solid: Solid, size: int, camera: CameraConfig, sigma_px: float) -> float:
+    """Checks the solid and the image size; returns sigma_px in world units at the object's distance."""
+    check_sor(solid.radius, solid.height, solid.pose)
+    if not (isinstance(size, int) and size >= 1) or not (math.isfinite(sigma_px) and sigma_px > 0):
+        raise InputError(f"size must be >= 1 and sigma_px > 0, got size={size}, sigma_px={sigma_px}")
+    return sigma_px * pixel_size(size, camera)
+
+
+def _active_rays(solid: Solid, size: int, camera: CameraConfig, sigma: float, soft_outside: bool):
+    """The rays that cross the bounding cylinder (inflated by the soft halo, or by a hair for hits alone).
+
+    Returns:
+        (rotation B x 3 x 3, unit camera-frame directions P x 3, object-frame directions B x P x 3, the active
+        rays _Rays (M), their flat index into B x P, their pixel index (M), their span (s_near, s_far) (M each)).
+    """
+    radius, height, pose = solid.radius, solid.height, solid.pose
+    rot, origin, dirs, d_obj = object_rays(pose, size, camera)
+    r_world, h_world = radius * camera.r_max, height * camera.r_max
+    cull = (CULL_SIGMAS if soft_outside else HIT_SIGMAS) * sigma  # bounding-cylinder margin: the soft halo or none
+    s_near, s_far = _span(origin.detach(), d_obj.detach(), r_world.detach().amax(1) + cull, h_world.detach() + cull)
+    active = s_far > s_near  # B x P
+    b_idx, p_idx = active.nonzero(as_tuple=True)
+    flat = b_idx * d_obj.shape[1] + p_idx
+    rays = _Rays(b_idx, origin.index_select(0, b_idx), d_obj.reshape(-1, 3).index_select(0, flat), r_world,
+                 h_world.index_select(0, b_idx))
+    return rot, dirs, d_obj, rays, flat, p_idx, (s_near[b_idx, p_idx], s_far[b_idx, p_idx])
 
 
 def _margin(rays: _Rays, s_min: torch.Tensor) -> torch.Tensor:

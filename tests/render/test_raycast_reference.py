@@ -8,7 +8,7 @@ import torch
 import trimesh
 
 from radar_cli.config import CameraConfig
-from radar_cli.render.raycast import cast_rays
+from radar_cli.render.raycast import cast_rays, hit_mask
 from radar_cli.sor.camera import pixel_rays, project
 from radar_cli.sor.mesh import triangulate
 from radar_cli.sor.pose import object_to_camera
@@ -68,3 +68,15 @@ def test_hits_only_search_leaves_every_hit_unchanged(random_sor):
         assert torch.allclose(a[on], b[on], rtol=0.0, atol=1e-6), name
     assert float(hits_only.sil[~on].abs().max()) == 0.0
     assert float(full.sil[~on].max()) > 0.4  # the full cast is soft just outside the outline
+
+
+@pytest.mark.parametrize("size", [64, 257])
+def test_hit_mask_is_the_casts_hard_silhouette(random_sor, size):
+    """hit_mask stops each ray's search at its first hits: the same mask as a full cast, bit for bit."""
+    radius, height, pose = random_sor(6, seed=4, dtype=torch.float32)
+    solid = Solid(radius, height, pose)
+    mask = hit_mask(solid, size, CameraConfig())
+    assert mask.dtype == torch.bool and mask.shape == (6, size, size)
+    assert torch.equal(mask, cast_rays(solid, size, CameraConfig(), 1.0, soft_outside=False).mask)
+    assert torch.equal(mask, cast_rays(solid, size, CameraConfig(), 1.0).mask)
+    assert 0 < int(mask.sum()) < mask.numel()

@@ -23,7 +23,7 @@ from radar_cli.derender.refine.shape_config import ShapeFitConfig
 from radar_cli.masks.refine import iou
 from radar_cli.model.outputs import Decomposition
 from radar_cli.model.specular_reader import SpecularReader
-from radar_cli.render.raycast import cast_rays
+from radar_cli.render.raycast import hit_mask
 from radar_cli.sor.outline import mask_outline, outline
 from radar_cli.sor.solid import Solid
 from radar_cli.threads import torch_threads
@@ -84,9 +84,7 @@ class RefineReport:
 def silhouette_iou(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, mask: np.ndarray,
                    camera: CameraConfig) -> float:
     """IoU of the ray-cast silhouette (N x N, hard) with an N x N bool mask."""
-    with torch.no_grad():
-        drawn = cast_rays(Solid(radius.float(), height.float(), pose.float()), mask.shape[0], camera, 1.0,
-                          soft_outside=False).mask[0].cpu().numpy()
+    drawn = hit_mask(Solid(radius.float(), height.float(), pose.float()), mask.shape[0], camera)[0].cpu().numpy()
     return iou(drawn, mask)
 
 
