@@ -131,9 +131,9 @@ def cast_rays(
     radius, height = solid.radius, solid.height
     n_batch, dev, dt = radius.shape[0], radius.device, radius.dtype
     sigma = _check(solid, size, camera, sigma_px)
-    rot, dirs, d_obj, rays, flat, p_idx, span = _active_rays(solid, size, camera, sigma, soft_outside)
+    rot, dirs, d_obj, rays, flat, p_idx, (s_near, s_far) = _active_rays(solid, size, camera, sigma, soft_outside)
     r_world = radius * camera.r_max
-    found = search(rays.o.detach(), rays.d.detach(), r_world.detach(), rays.b, rays.h.detach(), *span,
+    found = search(rays.o.detach(), rays.d.detach(), r_world.detach(), rays.b, rays.h.detach(), s_near, s_far,
                    deep=DEEP_SIGMAS * sigma, misses=soft_outside)
     g = _margin(rays, found.s_min)  # differentiable margin, world units
     # g is close to the distance from the ray to the solid, ~ pixels * pixel size at the object; the taper
@@ -168,8 +168,8 @@ def hit_mask(solid: Solid, size: int, camera: CameraConfig = CameraConfig()) -> 
     rays searched only as far as their first hits (about half the cost). B x size x size bool."""
     sigma = _check(solid, size, camera, 1.0)
     with torch.no_grad():
-        _, _, d_obj, rays, flat, _, span = _active_rays(solid, size, camera, sigma, False)
-        found = search(rays.o, rays.d, solid.radius * camera.r_max, rays.b, rays.h, *span, hits_only=True)
+        _, _, d_obj, rays, flat, _, (s_near, s_far) = _active_rays(solid, size, camera, sigma, False)
+        found = search(rays.o, rays.d, solid.radius * camera.r_max, rays.b, rays.h, s_near, s_far, hits_only=True)
         total = solid.radius.shape[0] * d_obj.shape[1]
         mask = torch.zeros(total, dtype=torch.bool, device=solid.radius.device).index_put((flat,), found.hit)
     return mask.view(-1, size, size)
@@ -183,7 +183,9 @@ def _check(solid: Solid, size: int, camera: CameraConfig, sigma_px: float) -> fl
     return sigma_px * pixel_size(size, camera)
 
 
-def _active_rays(solid: Solid, size: int, camera: CameraConfig, sigma: float, soft_outside: bool):
+def _active_rays(solid: Solid, size: int, camera: CameraConfig, sigma: float, soft_outside: bool
+                 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, _Rays, torch.Tensor, torch.Tensor,
+                            tuple[torch.Tensor, torch.Tensor]]:
     """The rays that cross the bounding cylinder (inflated by the soft halo, or by a hair for hits alone).
 
     Returns:

@@ -48,9 +48,9 @@ def test_quantized_frames_draw_the_views_and_load_back() -> None:
     assert error < 1.05 * pillow_error, (error, pillow_error)
     for index, view in zip(indices, views):
         # no other entry is nearer to any pixel
-        best = _brute_nearest(view.reshape(-1, 3)[::97], palette)
-        d = lambda i: ((palette[i].astype(np.int64) - view.reshape(-1, 3)[::97]) ** 2).sum(1)  # noqa: E731
-        assert np.array_equal(d(index.reshape(-1)[::97]), d(best))
+        pixels = view.reshape(-1, 3)[::97].astype(np.int64)
+        got, best = palette[index.reshape(-1)[::97]].astype(np.int64), palette[_brute_nearest(pixels, palette)]
+        assert np.array_equal(((got - pixels) ** 2).sum(1), ((best.astype(np.int64) - pixels) ** 2).sum(1))
     buffer = io.BytesIO()
     frames = gif_frames(views)
     frames[0].save(buffer, format="GIF", save_all=True, append_images=frames[1:])

@@ -23,7 +23,8 @@ def palette_of(pixels: np.ndarray) -> np.ndarray:
     sample = np.ascontiguousarray(pixels[::SAMPLE_STRIDE])[None]  # 1 x M' x 3
     quantized = Image.fromarray(sample).quantize(COLOURS, method=Image.Quantize.MEDIANCUT)
     used = int(np.asarray(quantized).max()) + 1
-    return np.asarray(quantized.getpalette()[: 3 * used], np.int32).reshape(used, 3)
+    entries = quantized.getpalette() or []  # a "P" image always has one
+    return np.asarray(entries[: 3 * used], np.int32).reshape(used, 3)
 
 
 def _candidates(palette: np.ndarray, cells: np.ndarray) -> np.ndarray:

@@ -9,10 +9,10 @@ time (Predictor.predict) and each object is refined and exported on one torch th
 from __future__ import annotations
 
 import time
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Sequence, TypeVar
+from typing import Callable, TypeVar
 
 import numpy as np
 import torch
@@ -41,9 +41,9 @@ from radar_cli.derender.run.upsample import full_resolution_state
 from radar_cli.errors import InputError, NothingToDoError, RadarError
 from radar_cli.fileio import remove_stale_temps
 from radar_cli.model.outputs import Decomposition
+from radar_cli.sizes import ObjectSize
 from radar_cli.threads import torch_threads
 
-T = TypeVar("T")
 R = TypeVar("R")
 EXPORT_THREADS = 1  # exports work on small tensors: one torch thread runs them faster (docs/performance.md, Threads)
 # errors of one object's export that must not stop the batch (decoding, writing, a degenerate prediction)
@@ -105,23 +105,30 @@ def environments(paths: tuple[Path, ...], height: int, width: int) -> dict[str, 
     return envs
 
 
-def _thread_map(fn: Callable[[T], R], items: Sequence[T], workers: int) -> list[R]:
-    """[fn(x) for x in items], in order, on up to `workers` threads (in this thread when workers <= 1)."""
-    if workers <= 1 or len(items) <= 1:
-        return [fn(x) for x in items]
-    with ThreadPoolExecutor(max_workers=min(workers, len(items))) as pool:
-        return list(pool.map(fn, items))
+class _Pool:
+    """Runs calls on up to `workers` threads (in the calling thread when workers <= 1, one call at a time, in
+    order). Every call runs on one torch thread (EXPORT_THREADS): OpenMP's thread count is per thread, so a pool
+    thread would otherwise spin up every core, and sum in another order than a one-worker run (other bytes)."""
 
+    def __init__(self, workers: int):
+        self.executor = ThreadPoolExecutor(max_workers=workers) if workers > 1 else None
 
-def _prepare_all(items: list[InputItem], size: int, options: DerenderOptions) -> list[Prepared | Failure]:
-    """Read and crop a batch of inputs (threads: decoding and detection release the GIL)."""
-    def one(item: InputItem) -> Prepared | Failure:
-        try:
-            return prepare(item, size, options.crop, options.backdrop, options.resolution)
-        except RadarError as e:
-            return Failure(str(item.image_path), str(e).removeprefix(f"{item.image_path}: "))
+    def submit(self, fn: Callable[..., R], *args) -> Future[R]:
+        if self.executor is not None:
+            return self.executor.submit(self._one_thread, fn, *args)
+        done: Future[R] = Future()
+        with torch_threads(EXPORT_THREADS):
+            done.set_result(fn(*args))
+        return done
 
-    return _thread_map(one, items, options.workers)
+    @staticmethod
+    def _one_thread(fn: Callable[..., R], *args) -> R:
+        torch.set_num_threads(EXPORT_THREADS)
+        return fn(*args)
+
+    def close(self) -> None:
+        if self.executor is not None:
+            self.executor.shutdown(wait=True)
 
 
 def collect(inputs: list[str | Path], options: DerenderOptions) -> tuple[list[InputItem], list[Failure]]:
@@ -187,11 +194,13 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
     several = [block[0] for block in shard.blocks([i for i in items if i.multiview], 1)]
     with sizes, torch_threads(options.threads), tqdm(total=sum(map(len, batches)) + len(several), desc="derender",
                                                      unit="obj", disable=None) as bar:
-        for batch in batches:
-            todo = _pending(batch, options.out, options.overwrite, summary, say)
-            if todo:
-                _run_batch(batch, todo, predictor, options, envs, summary, say, sizes)
-            bar.update(len(batch))
+        runner = _Batches(predictor, options, envs, summary, say, sizes, bar)
+        try:
+            for batch in batches:
+                runner.run(batch, _pending(batch, options.out, options.overwrite, summary, say))
+            runner.finish()
+        finally:
+            runner.pool.close()
         for item in several:
             if _pending([item], options.out, options.overwrite, summary, say):
                 _run_views(item, predictor, options, envs, summary, say, sizes)
@@ -205,24 +214,75 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
     return summary
 
 
-def _run_batch(chunk: list[InputItem], todo: set[str], predictor: Predictor, options: DerenderOptions,
-               envs: dict[str, np.ndarray], summary: BatchSummary, say: Callable[[str], None],
-               sizes: SizeFinder) -> None:
-    """Crop, predict and export the objects of a batch named in `todo`; failures are recorded item by item."""
-    chunk = [item for item in chunk if item.name in todo]
-    prepared = _prepare_all(chunk, predictor.setup.render.image_size, options)
-    ok = []
-    for item, prep in zip(chunk, prepared):
-        if isinstance(prep, Failure):
-            summary.failures.append(prep)
-            say(prep.line())
-        else:
-            ok.append((item, prep))
-    if not ok:
-        return
-    dec = predictor.predict([prep.image for _, prep in ok], [prep.silhouette for _, prep in ok])
-    with torch_threads(EXPORT_THREADS):
-        _export_all(ok, dec, predictor, options, envs, summary, say, sizes)
+class _Batches:
+    """Crops, predicts and exports the batches through one pool of options.workers threads, with no barrier
+    between batches: a batch's photos are read and located while the batch before it is still exported, and the
+    network reads them (in the calling thread) meanwhile. Outcomes are recorded in input order, whatever finished
+    first; each object's files are the same bytes as a one-worker run's (every export on one torch thread)."""
+
+    def __init__(self, predictor: Predictor, options: DerenderOptions, envs: dict[str, np.ndarray],
+                 summary: BatchSummary, say: Callable[[str], None], sizes: SizeFinder, bar: tqdm):
+        self.predictor, self.options, self.envs, self.summary, self.say = predictor, options, envs, summary, say
+        self.sizes, self.bar = sizes, bar
+        self.pool = _Pool(options.workers)
+        self.exporting: list[tuple[InputItem, Future[Failure | None]]] = []  # the batch before, in input order
+        self.size_of_exporting = 0  # its inputs, skipped ones included (the progress bar's steps)
+
+    def run(self, batch: list[InputItem], todo: set[str]) -> None:
+        """Start a batch (its objects named in `todo`; the others were skipped); records the batch before it."""
+        chunk = [item for item in batch if item.name in todo]
+        size, options = self.predictor.setup.render.image_size, self.options
+        reading = [self.pool.submit(_prepare_one, item, size, options) for item in chunk]
+        prepared = [f.result() for f in reading]
+        ok = [(item, prep) for item, prep in zip(chunk, prepared) if not isinstance(prep, Failure)]
+        exports = []
+        if ok:
+            dec = self.predictor.predict([prep.image for _, prep in ok], [prep.silhouette for _, prep in ok])
+            found = [self.sizes.find(item) for item, _ in ok]  # here: this thread holds the catalogs' connections
+            exports = [(item, self.pool.submit(self._export_one, item, prep, dec.select(k), found[k]))
+                       for k, (item, prep) in enumerate(ok)]
+        self.finish()
+        for prep in prepared:
+            if isinstance(prep, Failure):
+                self.summary.failures.append(prep)
+                self.say(prep.line())
+        self.exporting, self.size_of_exporting = exports, len(batch)
+
+    def finish(self) -> None:
+        """Wait for the batch being exported and record its outcomes."""
+        for item, future in self.exporting:
+            failure = future.result()
+            if failure is None:
+                self.summary.done.append(item.name)
+            else:
+                self.summary.failures.append(failure)
+                self.say(failure.line())
+        self.bar.update(self.size_of_exporting)
+        self.exporting, self.size_of_exporting = [], 0
+
+    def _export_one(self, item: InputItem, prep: Prepared, dec: Decomposition,
+                    found: ObjectSize | None) -> Failure | None:
+        """Refine and export one predicted object (batch of one `dec`); an error costs this object only."""
+        predictor = self.predictor
+        assert prep.photo_image is not None  # Prepared sets it
+        try:
+            refined, report = predictor.refine_object(dec, prep.image, prep.photo_image, prep.photo_silhouette)
+            if report.status == "fallback":
+                self.say(f"{item.image_path}: refinement fell back to the network's prediction: {report.reason}")
+            state = full_resolution_state(refined, prep, predictor.setup, predictor.albedo)
+            export_object(self.options.out / item.name, item, prep, state, predictor.setup, predictor.version,
+                          self.envs, self.options.export, predictor.albedo, predictor.pitch, report.record(), found)
+        except ITEM_ERRORS as e:
+            return Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
+        return None
+
+
+def _prepare_one(item: InputItem, size: int, options: DerenderOptions) -> Prepared | Failure:
+    """Read and crop one input (decoding and detection release the GIL)."""
+    try:
+        return prepare(item, size, options.crop, options.backdrop, options.resolution)
+    except RadarError as e:
+        return Failure(str(item.image_path), str(e).removeprefix(f"{item.image_path}: "))
 
 
 def _run_views(item: InputItem, predictor: Predictor, options: DerenderOptions, envs: dict[str, np.ndarray],
@@ -240,40 +300,3 @@ def _run_views(item: InputItem, predictor: Predictor, options: DerenderOptions, 
         return
     summary.failures.extend(left_out)
     summary.done.append(item.name)
-
-
-def _export_all(ok: list[tuple[InputItem, Prepared]], dec: Decomposition, predictor: Predictor,
-                options: DerenderOptions, envs: dict[str, np.ndarray], summary: BatchSummary,
-                say: Callable[[str], None], sizes: SizeFinder) -> None:
-    """Export each predicted object, options.workers at a time (threads: PNG and zlib encoding
-    and torch's operations release the GIL, and each object writes its own folder); an error costs that object
-    only. Sizes are looked up here, in the calling thread (it holds the catalogs' connections)."""
-    ks = list(range(len(ok)))
-    found = {k: sizes.find(ok[k][0]) for k in ks}
-
-    def one(k: int) -> Failure | None:
-        # OpenMP's thread count is per thread: a pool thread would otherwise spin up every core, and sum in
-        # another order than a one-worker run (different bytes)
-        torch.set_num_threads(EXPORT_THREADS)
-        item, prep = ok[k]
-        assert prep.photo_image is not None  # Prepared sets it
-        try:
-            refined, report = predictor.refine_object(dec.select(k), prep.image, prep.photo_image,
-                                                      prep.photo_silhouette)
-            if report.status == "fallback":
-                say(f"{item.image_path}: refinement fell back to the network's prediction: {report.reason}")
-            state = full_resolution_state(refined, prep, predictor.setup, predictor.albedo)
-            export_object(options.out / item.name, item, prep, state, predictor.setup, predictor.version, envs,
-                          options.export, predictor.albedo, predictor.pitch, report.record(), found[k])
-        except ITEM_ERRORS as e:
-            return Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
-        return None
-
-    # recorded in input order, whatever finished first
-    for k, failure in zip(ks, _thread_map(one, ks, options.workers)):
-        item = ok[k][0]
-        if failure is None:
-            summary.done.append(item.name)
-        else:
-            summary.failures.append(failure)
-            say(failure.line())
