@@ -1,0 +1,100 @@
+"""CPU seconds of three parts of a `radar derender` object, each against the way it was done before, over the
+objects of a results folder (docs/performance.md):
+
+    python -m experiments.export_parts RESULTS [--repeats 3]
+
+- the turntable GIF's palette: Pillow's median cut of every pixel of turntable.png's frames (and its mapping)
+  against export.palette.quantize; each one's mean error against the frames (levels);
+- mesh.obj: trimesh's OBJ exporter against export.mesh.obj_text (the bytes compared);
+- the refinement's hard silhouette at the output side: a full ray cast against render.raycast.hit_mask, for the
+  profile, height and pose of material.json (the masks compared).
+
+Each figure is the best of `repeats` (one torch thread; run with OMP_NUM_THREADS=1)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+import torch
+import trimesh
+from PIL import Image
+
+from radar_cli.config import CameraConfig
+from radar_cli.derender.export.mesh import OBJ_MTL, obj_text
+from radar_cli.derender.export.palette import quantize
+from radar_cli.render.raycast import cast_rays, hit_mask
+from radar_cli.sor.solid import Solid
+
+
+def best_cpu(fn: Callable[[], Any], repeats: int) -> tuple[float, Any]:
+    """(the least CPU seconds of `repeats` calls, the last call's result)."""
+    least, out = float("inf"), None
+    for _ in range(repeats):
+        start = time.process_time()
+        out = fn()
+        least = min(least, time.process_time() - start)
+    return least, out
+
+
+def gif_palette(folder: Path, repeats: int) -> list[float]:
+    """[Pillow s, radar s, Pillow error, radar error] for the object's turntable frames."""
+    strip = np.asarray(Image.open(folder / "turntable.png").convert("RGB"))
+    side = strip.shape[0]
+    views = [np.ascontiguousarray(strip[:, k * side:(k + 1) * side]) for k in range(strip.shape[1] // side)]
+    image = Image.fromarray(strip)
+    old_s, old = best_cpu(lambda: image.quantize(256, method=Image.Quantize.MEDIANCUT), repeats)
+    new_s, (indices, palette) = best_cpu(lambda: quantize(views), repeats)
+    old_err = np.abs(np.asarray(old.convert("RGB"), np.float64) - strip).mean()
+    new_err = np.mean([np.abs(palette[i].astype(np.float64) - v).mean() for i, v in zip(indices, views)])
+    return [old_s, new_s, float(old_err), float(new_err)]
+
+
+def obj_file(folder: Path, repeats: int) -> list[float]:
+    """[trimesh s, radar s, 1 if the bytes agree] for the object's mesh.obj read back (the text alone: the
+    texture's PNG, which both write, left out)."""
+    mesh = trimesh.load(folder / "mesh.obj", force="mesh", process=False, maintain_order=True)
+    mesh.metadata.pop("name", None)  # the file's name, which the exporter would write as an `o` line
+    mesh.visual.material.image = None
+    export = trimesh.exchange.obj.export_obj
+    old_s, (text, _) = best_cpu(lambda: export(mesh, include_texture=True, return_texture=True, mtl_name=OBJ_MTL),
+                                repeats)
+    new_s, ours = best_cpu(lambda: obj_text(mesh.vertices, mesh.visual.uv, mesh.faces, "albedo"), repeats)
+    return [old_s, new_s, float(text.encode("utf-8") == ours)]
+
+
+def iou_cast(folder: Path, repeats: int) -> list[float]:
+    """[full cast s, hit_mask s, 1 if the masks agree] at material.json's resolution (its 128-row profile: the
+    refinement's are 32 and 64 rows, so cheaper)."""
+    record = json.loads((folder / "material.json").read_text())
+    solid = Solid(torch.tensor([record["radius"]], dtype=torch.float32), torch.tensor([record["height"]]),
+                  torch.tensor([[record["pitch"], record["roll"], record["tx"], record["ty"]]]))
+    size, camera = int(record["resolution"]), CameraConfig()
+    with torch.no_grad():
+        old_s, old = best_cpu(lambda: cast_rays(solid, size, camera, 1.0, soft_outside=False).mask, repeats)
+        new_s, new = best_cpu(lambda: hit_mask(solid, size, camera), repeats)
+    return [old_s, new_s, float(torch.equal(old, new))]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("results", type=Path)
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+    torch.set_num_threads(1)
+    folders = sorted(p.parent for p in args.results.glob("*/material.json"))
+    parts = {"gif": gif_palette, "obj": obj_file, "iou_cast": iou_cast}
+    rows = {name: np.array([fn(f, args.repeats) for f in folders]) for name, fn in parts.items()}
+    print(f"{len(folders)} objects")
+    for name, table in rows.items():
+        extra = table[:, 2:].mean(0).round(3).tolist()
+        print(f"{name}: before {table[:, 0].mean():.3f} CPU s ({table[:, 0].min():.3f}-{table[:, 0].max():.3f}), "
+              f"after {table[:, 1].mean():.3f} ({table[:, 1].min():.3f}-{table[:, 1].max():.3f}); {extra}")
+
+
+if __name__ == "__main__":
+    main()
