@@ -14,7 +14,7 @@ import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig, RenderConfig
 from radar_cli.derender.export.object_folder import ExportConfig
-from radar_cli.derender.multiview.fuse import fuse, match_exposure, unwrap_view
+from radar_cli.derender.multiview.fuse import FuseConfig, ViewTexture, fuse, match_exposure, unwrap_view
 from radar_cli.derender.multiview.turns import register_turns
 from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.run.inputs import collect_inputs
@@ -98,6 +98,22 @@ def test_fused_texture_matches_on_every_side_and_the_mirrored_one_does_not(synth
     single_errors = side_errors(single, albedo)
     assert single_errors[0] > 3 * max(fused_errors), (single_errors, fused_errors)  # the back is the front mirrored
     assert single_errors[0] > 0.08
+
+
+def test_a_texel_seen_only_at_the_limb_is_drawn_by_its_mirror_image() -> None:
+    """One view sees the right half squarely (albedo 0.3) and the left half only at its limb, where glossy glaze
+    reflects the studio (0.9): the left half is drawn by its mirror image, the right half by the view alone."""
+    albedo = torch.full((1, 3, 4, 12), 0.3)
+    albedo[..., :6] = 0.9
+    weight = torch.full((1, 1, 4, 12), 0.9)
+    weight[..., :6] = 0.15
+    view = ViewTexture(albedo, weight)
+    fused = fuse([view])
+    plain = fuse([view], FuseConfig(mirror_weight=0.0))
+    assert float(fused.albedo[..., 2].max()) < 0.35 < 0.5 < float(plain.albedo[..., 2].min())
+    assert torch.allclose(fused.albedo[..., 6:], albedo[..., 6:]) and torch.allclose(fused.seen[..., 6:],
+                                                                                      torch.ones(4, 6))
+    assert float(fused.seen[..., 2].max()) < 0.1  # coverage shows the limb texels as mirrored
 
 
 def test_coverage_shows_what_no_view_sees(synthetic) -> None:

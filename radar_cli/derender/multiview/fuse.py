@@ -33,11 +33,18 @@ class FuseConfig:
         power: a view's weight is its foreshortening cosine to this power (higher: the best view dominates more,
             narrower blends at the seams).
         seen: (lo, hi) of the best view's cosine over which a texel goes from mirrored to seen.
+        mirror_weight, mirror_below: where no view sees a texel more squarely than mirror_below (a ramp of the
+            best view's cosine, from all to none), its mirror image about the first view's axis joins the blend as
+            one more view, weighted mirror_weight x the views' weight at the mirror image: a texel seen only at
+            the views' limbs (where glossy glaze reflects the studio) is drawn mostly by its mirror image where
+            a view sees that squarely. Texels a view sees squarely are the views' alone.
         min_gain, max_gain: the exposure match's bounds on a view's gain per channel.
     """
 
     power: float = 4.0
     seen: tuple[float, float] = (0.08, 0.25)
+    mirror_weight: float = 0.3
+    mirror_below: tuple[float, float] = (0.25, 0.45)
     min_gain: float = 0.5
     max_gain: float = 2.0
 
@@ -143,18 +150,25 @@ class Fused:
 
 
 def fuse(views: list[ViewTexture], config: FuseConfig = FuseConfig()) -> Fused:
-    """Blend views already turned into the object's frame (and exposure-matched): weights cos^power; where no view
-    sees a texel, the texel mirrored about the first view's axis, or else its row's mean over the seen texels."""
+    """Blend views already turned into the object's frame (and exposure-matched): weights cos^power, the texel's
+    mirror image about the first view's axis weighted config.mirror_weight x the views' weight there; where no
+    view sees a texel, its mirror image, or else its row's mean over the seen texels."""
     weight = torch.cat([v.weight for v in views])[:, 0]  # V x Ht x W
     albedo = torch.cat([v.albedo for v in views])  # V x 3 x Ht x W
     w = weight ** config.power
-    total = w.sum(0)
-    blended = (albedo * w[:, None]).sum(0) / total.clamp_min(1e-12)  # 3 x Ht x W
+    own = w.sum(0)  # Ht x W
+    views_blend = (albedo * w[:, None]).sum(0) / own.clamp_min(1e-12)  # 3 x Ht x W
+    best = weight.max(0).values  # Ht x W
+    a, b = config.mirror_below
+    squarely = ((best - a) / (b - a)).clamp(0.0, 1.0)  # Ht x W: some view sees it squarely (no mirror)
+    mirror = config.mirror_weight * own.flip(-1) * (1 - squarely)
+    total = (own + mirror).clamp_min(1e-12)
+    blended = (own * views_blend + mirror * views_blend.flip(-1)) / total
     lo, hi = config.seen
-    seen = ((weight.max(0).values - lo) / (hi - lo)).clamp(0.0, 1.0)  # Ht x W
-    mirrored, mirror_seen = blended.flip(-1), seen.flip(-1)
-    row_mean = (blended * seen).sum(-1, keepdim=True) / seen.sum(-1, keepdim=True).clamp_min(1e-6)
-    fill = mirror_seen * mirrored + (1 - mirror_seen) * row_mean
-    fused = seen * blended + (1 - seen) * fill
-    share = w / total.clamp_min(1e-12) * seen
-    return Fused(fused[None].clamp(0, 1), share, seen)
+    reach = ((best - lo) / (hi - lo)).clamp(0.0, 1.0)  # Ht x W: some view sees it
+    mirrored, mirror_reach = blended.flip(-1), reach.flip(-1)
+    row_mean = (blended * reach).sum(-1, keepdim=True) / reach.sum(-1, keepdim=True).clamp_min(1e-6)
+    fill = mirror_reach * mirrored + (1 - mirror_reach) * row_mean
+    fused = reach * blended + (1 - reach) * fill
+    share = w / total * reach  # each view's share; the rest is mirrored
+    return Fused(fused[None].clamp(0, 1), share, share.sum(0))
