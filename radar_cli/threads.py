@@ -1,11 +1,15 @@
-"""Torch's intra-op thread count, set for a block of work."""
+"""Torch's intra-op thread count, set for a block of work; independent pieces of work on a few threads."""
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
-from typing import Iterator
+from typing import Callable, Iterator, Sequence, TypeVar
 
 import torch
+
+T = TypeVar("T")
+R = TypeVar("R")
 
 
 @contextmanager
@@ -21,3 +25,19 @@ def torch_threads(n: int) -> Iterator[None]:
         yield
     finally:
         torch.set_num_threads(before)
+
+
+def thread_map(fn: Callable[[T], R], items: Sequence[T], workers: int) -> list[R]:
+    """[fn(x) for x in items], in order, on up to `workers` threads (in this thread when workers <= 1), each call
+    on one torch thread: OpenMP's thread count is per thread, so a pool thread would otherwise spin up every core
+    and sum in another order than a one-worker run (other bytes). OpenCV, zlib and torch's operations release the
+    GIL; Python between them does not."""
+    if workers <= 1 or len(items) <= 1:
+        return [fn(x) for x in items]
+
+    def one(x: T) -> R:
+        torch.set_num_threads(1)
+        return fn(x)
+
+    with ThreadPoolExecutor(max_workers=min(workers, len(items))) as pool:
+        return list(pool.map(one, items))

@@ -175,3 +175,21 @@ def test_eval_views_scores_every_side_view(tmp_path: Path, predictor: Predictor)
     assert (tmp_path / "out" / "held_out.csv").read_text().count("\n") == 4
     assert (tmp_path / "out" / "pot.png").is_file()
     assert "3 held-out views of 1 objects" in summary_line(rows)
+
+
+def test_a_multiview_object_gives_the_same_bytes_with_one_worker_or_two(tmp_path: Path, predictor: Predictor) -> None:
+    """Its views are read and fitted two at a time with two workers: every file is the same as one at a time."""
+    for seed, view in enumerate(("front", "back", "side")):
+        write_photo(tmp_path / "in" / "pot" / f"{view}.png", 3 + seed, (80, 80))
+    outs = []
+    for workers in (1, 2):
+        out = tmp_path / f"out{workers}"
+        summary = derender([tmp_path / "in"], predictor, DerenderOptions(
+            out=out, workers=workers, export=ExportConfig(views=2, view_size=32)), say=lambda line: None)
+        assert summary.done == ["pot"]
+        outs.append(out / "pot")
+    names = sorted(p.name for p in outs[0].iterdir())
+    assert names == sorted(p.name for p in outs[1].iterdir()) and "albedo.png" in names
+    for name in names:
+        if (outs[0] / name).is_file():
+            assert (outs[0] / name).read_bytes() == (outs[1] / name).read_bytes(), name

@@ -30,6 +30,7 @@ from radar_cli.derender.run.predictor import Predictor
 from radar_cli.errors import InputError, RadarError
 from radar_cli.results import COVERAGE_FILE
 from radar_cli.sizes import ObjectSize
+from radar_cli.threads import thread_map
 
 
 def same_side(prepared: Prepared, side: int) -> Prepared:
@@ -44,19 +45,25 @@ def same_side(prepared: Prepared, side: int) -> Prepared:
 
 
 def read_views(item: InputItem, size: int, crop: CropMode, backdrop: Backdrop, resolution: Resolution,
-               say: Callable[[str], None]) -> tuple[list[ViewFit], list[Failure]]:
-    """Every photo of the object prepared (prepare) at the smallest view's output side; an unreadable one is a
-    ViewFit without crops, a Failure and one line."""
-    views, failures = [], []
-    for path in item.views:
+               say: Callable[[str], None], workers: int = 1) -> tuple[list[ViewFit], list[Failure]]:
+    """Every photo of the object prepared (prepare, `workers` at a time) at the smallest view's output side; an
+    unreadable one is a ViewFit without crops, a Failure and one line."""
+    def read(path: Path) -> Prepared | RadarError:
         try:
-            views.append(ViewFit(str(path), prepare(InputItem(item.name, path), size, crop, backdrop, resolution)))
+            return prepare(InputItem(item.name, path), size, crop, backdrop, resolution)
         except RadarError as e:
-            problem = str(e).removeprefix(f"{path}: ")
+            return e
+
+    views, failures = [], []
+    for path, prepared in zip(item.views, thread_map(read, item.views, workers)):
+        if isinstance(prepared, RadarError):
+            problem = str(prepared).removeprefix(f"{path}: ")
             failure = Failure(str(path), f"{problem}; left out, {item.name} goes on with its other views")
             say(failure.line())
             failures.append(failure)
             views.append(ViewFit(str(path), None, reason=f"unreadable ({problem})"))
+        else:
+            views.append(ViewFit(str(path), prepared))
     readable = [v for v in views if v.prepared is not None]
     if not readable:
         raise InputError(f"{item.image_path.parent}: none of the object's {len(item.views)} photos could be read")
@@ -67,26 +74,27 @@ def read_views(item: InputItem, size: int, crop: CropMode, backdrop: Backdrop, r
 
 
 def fit_views(item: InputItem, predictor: Predictor, crop: CropMode, backdrop: Backdrop, resolution: Resolution,
-              say: Callable[[str], None], config: MultiviewConfig = MultiviewConfig()) -> tuple[ObjectFit,
-                                                                                               list[Failure]]:
-    """Read, predict and fit one multi-view object (its Failures: the photos left out unread)."""
-    views, failures = read_views(item, predictor.setup.render.image_size, crop, backdrop, resolution, say)
+              say: Callable[[str], None], config: MultiviewConfig = MultiviewConfig(),
+              workers: int = 1) -> tuple[ObjectFit, list[Failure]]:
+    """Read, predict and fit one multi-view object, its views `workers` at a time (its Failures: the photos left
+    out unread)."""
+    views, failures = read_views(item, predictor.setup.render.image_size, crop, backdrop, resolution, say, workers)
     readable = [v.crops for v in views if v.prepared is not None]
     dec = predictor.predict([p.image for p in readable], [p.silhouette for p in readable])
     decs = [dec.select(k) for k in range(len(readable))]
-    return fit_object(views, decs, predictor, config), failures
+    return fit_object(views, decs, predictor, config, workers), failures
 
 
 def derender_views(item: InputItem, predictor: Predictor, out: Path, crop: CropMode, backdrop: Backdrop,
                    resolution: Resolution, envs: dict[str, np.ndarray], export: ExportConfig,
-                   say: Callable[[str], None], size: ObjectSize | None = None) -> list[Failure]:
-    """De-render one multi-view object into out/<name>/ (at its catalogued size if known, as export_object);
-    returns the photos left out unread (the object is done).
+                   say: Callable[[str], None], size: ObjectSize | None = None, workers: int = 1) -> list[Failure]:
+    """De-render one multi-view object into out/<name>/ (at its catalogued size if known, as export_object), its
+    views read and fitted `workers` at a time; returns the photos left out unread (the object is done).
 
     Raises:
         RadarError, ValueError, RuntimeError, OSError: the object could not be de-rendered.
     """
-    fit, failures = fit_views(item, predictor, crop, backdrop, resolution, say)
+    fit, failures = fit_views(item, predictor, crop, backdrop, resolution, say, workers=workers)
     for view in fit.views:
         if view.prepared is not None and not view.used:
             say(f"{view.source}: left out of {item.name}'s fit: {view.reason}")

@@ -26,7 +26,7 @@ from radar_cli.derender.run.upsample import PROFILE_ROWS, photo_tensors
 from radar_cli.model.outputs import Decomposition
 from radar_cli.sor.resample import smooth_rows
 from radar_cli.sor.solid import Solid
-from radar_cli.threads import torch_threads
+from radar_cli.threads import thread_map, torch_threads
 
 
 @dataclass(frozen=True)
@@ -149,14 +149,15 @@ class ObjectFit:
 
 
 def own_fits(views: list[ViewFit], decs: list[Decomposition], config: MultiviewConfig,
-             camera: CameraConfig) -> None:
-    """Each view's own shape fit (fit_shape, the network's pitch as its prior); a view whose fit fails is left
-    out."""
-    for view, dec in zip([v for v in views if v.prepared is not None], decs):
+             camera: CameraConfig, workers: int = 1) -> None:
+    """Each view's own shape fit (fit_shape, the network's pitch as its prior), `workers` at a time; a view whose
+    fit fails is left out."""
+    def fit(pair: tuple[ViewFit, Decomposition]) -> None:
+        view, dec = pair
         view.network = dec
         if view.crops.photo_silhouette is None:
             view.reason = "no silhouette to fit (--crop none without --masks)"
-            continue
+            return
         grey = view.photo.astype(np.float32).mean(axis=2) / 255.0
         try:
             with torch_threads(1):
@@ -164,6 +165,8 @@ def own_fits(views: list[ViewFit], decs: list[Decomposition], config: MultiviewC
             view.used = True
         except FIT_ERRORS as e:
             view.reason = f"its shape fit failed ({type(e).__name__}: {e})"
+
+    thread_map(fit, list(zip([v for v in views if v.prepared is not None], decs)), workers)
 
 
 def choose_side_views(views: list[ViewFit], config: MultiviewConfig) -> None:
@@ -221,22 +224,22 @@ def exported_solid(dec: Decomposition) -> Solid:
 
 
 def fit_object(views: list[ViewFit], decs: list[Decomposition], predictor: Predictor,
-               config: MultiviewConfig = MultiviewConfig()) -> ObjectFit:
+               config: MultiviewConfig = MultiviewConfig(), workers: int = 1) -> ObjectFit:
     """Fit an object from its views (the readable ones prepared at the same output side N) and the network's
-    reading of each readable one (decs, in order).
+    reading of each readable one (decs, in order); the views' own work `workers` at a time.
 
     Raises:
         ValueError: no view could be fitted.
     """
-    own_fits(views, decs, config, predictor.setup.camera)
+    own_fits(views, decs, config, predictor.setup.camera, workers)
     choose_side_views(views, config)
-    return fit_chosen(views, predictor, config)
+    return fit_chosen(views, predictor, config, workers=workers)
 
 
 def fit_chosen(views: list[ViewFit], predictor: Predictor, config: MultiviewConfig = MultiviewConfig(),
-               turns: list[float] | None = None) -> ObjectFit:
+               turns: list[float] | None = None, workers: int = 1) -> ObjectFit:
     """The shared profile, appearances, turns (registered, or as given per used view) and fused albedo of the
-    views marked used (own fits done)."""
+    views marked used (own fits done); each view's appearance and texture `workers` at a time."""
     used = [v for v in views if v.used]
     if not used:
         raise ValueError("no view could be fitted: " + "; ".join(f"{v.source}: {v.reason}" for v in views))
@@ -244,8 +247,12 @@ def fit_chosen(views: list[ViewFit], predictor: Predictor, config: MultiviewConf
                                      config.shape, predictor.setup.camera)
     for view, geometry, error in zip(used, geometries, errors):
         view.geometry, view.outline_px = geometry, error
+
+    def look(view: ViewFit) -> None:
         read_appearance(view, predictor)
         view.texture = unwrap_texture(view, predictor)
+
+    thread_map(look, used, workers)
     if turns is None:
         found = register_turns([v.tex for v in used], config.turns,
                                [handle_phase(v.mask, v.crops.appendages) for v in used])

@@ -292,7 +292,8 @@ def _run_views(item: InputItem, predictor: Predictor, options: DerenderOptions, 
     try:
         with torch_threads(EXPORT_THREADS):
             left_out = derender_views(item, predictor, options.out, options.crop, options.backdrop,
-                                      options.resolution, envs, options.export, say, sizes.find(item))
+                                      options.resolution, envs, options.export, say, sizes.find(item),
+                                      options.workers)
     except ITEM_ERRORS as e:
         failure = Failure(str(item.image_path.parent), f"multi-view object failed ({type(e).__name__}: {e})")
         summary.failures.append(failure)
