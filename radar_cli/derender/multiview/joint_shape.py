@@ -8,6 +8,7 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig
+from radar_cli.derender.refine.adam import Adam
 from radar_cli.derender.refine.fit_shape import ShapeFit, downsample, outline_score, roughness
 from radar_cli.derender.refine.shape_config import ShapeFitConfig
 from radar_cli.sor.outline import Outline, mask_outline, outline
@@ -56,7 +57,7 @@ def _polish(target: Outline, size: int, profile: torch.Tensor, height: torch.Ten
         radius = ((shape / 100)[None] * h[:, None]).clamp(0.02, 1.0)
         return radius, h, torch.cat([pitch, own[:, 1:2], own[:, 2:] / 100], 1)
 
-    opt = torch.optim.Adam([shape, own], lr=config.polish_lr)
+    opt = Adam([shape, own], lr=config.polish_lr)
     for _ in range(steps):
         opt.zero_grad()
         r, h, p = unpack()

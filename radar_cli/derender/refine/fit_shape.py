@@ -22,6 +22,7 @@ import torch
 import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig
+from radar_cli.derender.refine.adam import Adam
 from radar_cli.derender.refine.bands import band_coherence, high_pass
 from radar_cli.derender.refine.pitch_cues import lip_contrast, pick_cue, top_error
 from radar_cli.derender.refine.shape_config import ShapeFitConfig
@@ -257,7 +258,7 @@ def polish(target: Outline, size: int, radius: torch.Tensor, height: torch.Tenso
         tail = torch.cat([pitch, v[:, rows + 1 : rows + 2], v[:, rows + 2 :] / 100], 1)
         return (v[:, :rows] / 100).clamp(0.02, 1.0), v[:, rows] / 100, tail
 
-    opt = torch.optim.Adam([x], lr=config.polish_lr)
+    opt = Adam([x], lr=config.polish_lr)
     for _ in range(steps):
         opt.zero_grad()
         r, h, p = unpack(x)
