@@ -27,17 +27,19 @@ def torch_threads(n: int) -> Iterator[None]:
         torch.set_num_threads(before)
 
 
+def on_torch_threads(n: int, fn: Callable[..., R], *args) -> R:
+    """fn(*args) with this thread's torch intra-op threads set to n, for a pool thread: OpenMP's thread count is
+    per thread, so a pool thread would otherwise spin up every core and sum in another order than the calling
+    thread (other bytes)."""
+    torch.set_num_threads(n)
+    return fn(*args)
+
+
 def thread_map(fn: Callable[[T], R], items: Sequence[T], workers: int) -> list[R]:
     """[fn(x) for x in items], in order, on up to `workers` threads (in this thread when workers <= 1), each call
-    on one torch thread: OpenMP's thread count is per thread, so a pool thread would otherwise spin up every core
-    and sum in another order than a one-worker run (other bytes). OpenCV, zlib and torch's operations release the
-    GIL; Python between them does not."""
+    on one torch thread (on_torch_threads). OpenCV, zlib and torch's operations release the GIL; Python between
+    them does not."""
     if workers <= 1 or len(items) <= 1:
         return [fn(x) for x in items]
-
-    def one(x: T) -> R:
-        torch.set_num_threads(1)
-        return fn(x)
-
     with ThreadPoolExecutor(max_workers=min(workers, len(items))) as pool:
-        return list(pool.map(one, items))
+        return list(pool.map(lambda x: on_torch_threads(1, fn, x), items))

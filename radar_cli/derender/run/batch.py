@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import Callable, TypeVar
 
 import numpy as np
-import torch
 from tqdm import tqdm
 
 from radar_cli.derender.export.environments import builtin_environments, env_name, load_environment
@@ -42,7 +41,7 @@ from radar_cli.errors import InputError, NothingToDoError, RadarError
 from radar_cli.fileio import remove_stale_temps
 from radar_cli.model.outputs import Decomposition
 from radar_cli.sizes import ObjectSize
-from radar_cli.threads import torch_threads
+from radar_cli.threads import on_torch_threads, torch_threads
 
 R = TypeVar("R")
 EXPORT_THREADS = 1  # exports work on small tensors: one torch thread runs them faster (docs/performance.md, Threads)
@@ -107,24 +106,18 @@ def environments(paths: tuple[Path, ...], height: int, width: int) -> dict[str, 
 
 class _Pool:
     """Runs calls on up to `workers` threads (in the calling thread when workers <= 1, one call at a time, in
-    order). Every call runs on one torch thread (EXPORT_THREADS): OpenMP's thread count is per thread, so a pool
-    thread would otherwise spin up every core, and sum in another order than a one-worker run (other bytes)."""
+    order), every call on EXPORT_THREADS torch threads (threads.on_torch_threads)."""
 
     def __init__(self, workers: int):
         self.executor = ThreadPoolExecutor(max_workers=workers) if workers > 1 else None
 
     def submit(self, fn: Callable[..., R], *args) -> Future[R]:
         if self.executor is not None:
-            return self.executor.submit(self._one_thread, fn, *args)
+            return self.executor.submit(on_torch_threads, EXPORT_THREADS, fn, *args)
         done: Future[R] = Future()
         with torch_threads(EXPORT_THREADS):
             done.set_result(fn(*args))
         return done
-
-    @staticmethod
-    def _one_thread(fn: Callable[..., R], *args) -> R:
-        torch.set_num_threads(EXPORT_THREADS)
-        return fn(*args)
 
     def close(self) -> None:
         if self.executor is not None:
