@@ -168,13 +168,18 @@ def _search(target: Outline, grey: torch.Tensor, size: int, pitches: torch.Tenso
     """Score a grid of candidate pitches: (shapes, outline + bending scores B, lip contrasts B, top-edge
     errors B, outline + uncapped bending B, lip contrasts relative to their sides' grey level B)."""
     radius, height, pose = closed_form(target, size, pitches, roll, tx, config, camera)
+    score, top, smooth = _outline_scores(target, size, radius, height, pose, config, camera)
+    contrast, level = lip_contrast(grey, radius, height, pose, lip_offset_px, camera)
+    return (radius, height, pose), score, contrast, top, smooth, contrast / (level + config.lip_dark)
+
+
+def _outline_scores(target: Outline, size: int, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
+                    config: ShapeFitConfig, camera: CameraConfig) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """B candidates' (outline + bending capped at corners, top-edge error, outline + uncapped bending)."""
     drawn = outline(Solid(radius, height, pose), size, camera)
     fit = outline_score(drawn, target)
-    score = fit + config.roughness_weight * roughness(radius, config.corner)
-    smooth = fit + config.roughness_weight * roughness(radius)
-    contrast, level = lip_contrast(grey, radius, height, pose, lip_offset_px, camera)
-    return ((radius, height, pose), score, contrast, top_error(drawn, target), smooth,
-            contrast / (level + config.lip_dark))
+    return (fit + config.roughness_weight * roughness(radius, config.corner), top_error(drawn, target),
+            fit + config.roughness_weight * roughness(radius))
 
 
 def _second_look(target: Outline, size: int, shapes: tuple[torch.Tensor, torch.Tensor, torch.Tensor],
@@ -204,10 +209,7 @@ def _second_look(target: Outline, size: int, shapes: tuple[torch.Tensor, torch.T
     radius, height, pose = shapes
     better = correct_widths(target, size, radius[redo].clone(), height[redo], pose[redo], config.lip_width_rounds,
                             camera, config.end_px * size / 256)
-    drawn = outline(Solid(better, height[redo], pose[redo]), size, camera)
-    fit = outline_score(drawn, target)
-    values = (fit + config.roughness_weight * roughness(better, config.corner), top_error(drawn, target),
-              fit + config.roughness_weight * roughness(better))
+    values = _outline_scores(target, size, better, height[redo], pose[redo], config, camera)
     radius = radius.index_copy(0, redo, better)
     return (radius, height, pose), tuple(t.index_copy(0, redo, v) for t, v in zip(scores, values))
 
