@@ -26,3 +26,13 @@ def test_a_strong_lip_outside_the_basin_is_looked_at_again():
     assert cue == "lip" and abs(pitch - truth) <= 1.0, (pitch, cue, truth)
     level, cue = searched_pitch(grey, mask, dataclasses.replace(ShapeFitConfig(), lip_width_rounds=0))
     assert truth - level > 10.0, (level, cue)  # without the second look the silhouette reads it level
+
+
+def test_a_dark_lip_outside_the_top_edges_basin_is_looked_at_again():
+    """A vase at 19.5 deg, a black mouth over a dark neck: at its true pitch the closed-form rim is drawn too
+    wide, so its top edge left the candidate out of the cues' basin (the outline's basin held it)."""
+    grey, mask, truth = synthetic_vase(17, 27)
+    pitch, cue = searched_pitch(grey, mask, ShapeFitConfig())
+    assert cue == "dark_lip" and abs(pitch - truth) <= 1.0, (pitch, cue, truth)
+    level, _ = searched_pitch(grey, mask, dataclasses.replace(ShapeFitConfig(), lip_width_rounds=0))
+    assert truth - level > 10.0, level

@@ -166,11 +166,13 @@ def _search(target: Outline, grey: torch.Tensor, size: int, pitches: torch.Tenso
             ) -> tuple[tuple[torch.Tensor, torch.Tensor, torch.Tensor], torch.Tensor, torch.Tensor, torch.Tensor,
                        torch.Tensor, torch.Tensor]:
     """Score a grid of candidate pitches: (shapes, outline + bending scores B, lip contrasts B, top-edge
-    errors B, outline + uncapped bending B, lip contrasts relative to their sides' grey level B)."""
+    errors B, outline + uncapped bending B, lip contrasts relative to their sides' grey level B, 0 where less than
+    config.lip_share of the arc is darker above)."""
     radius, height, pose = closed_form(target, size, pitches, roll, tx, config, camera)
     score, top, smooth = _outline_scores(target, size, radius, height, pose, config, camera)
-    contrast, level = lip_contrast(grey, radius, height, pose, lip_offset_px, camera)
-    return (radius, height, pose), score, contrast, top, smooth, contrast / (level + config.lip_dark)
+    contrast, level, share = lip_contrast(grey, radius, height, pose, lip_offset_px, camera)
+    relative = torch.where(share >= config.lip_share, contrast / (level + config.lip_dark), torch.zeros_like(level))
+    return (radius, height, pose), score, contrast, top, smooth, relative
 
 
 def _outline_scores(target: Outline, size: int, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
@@ -186,11 +188,12 @@ def _second_look(target: Outline, size: int, shapes: tuple[torch.Tensor, torch.T
                  scores: tuple[torch.Tensor, torch.Tensor, torch.Tensor], contrast: torch.Tensor,
                  relative: torch.Tensor, config: ShapeFitConfig, camera: CameraConfig
                  ) -> tuple[tuple[torch.Tensor, torch.Tensor, torch.Tensor], tuple[torch.Tensor, ...]]:
-    """The candidates outside the outline's basin whose lip is strong enough to pick (plain or relative), with
-    their profiles' widths corrected (correct_widths, config.lip_width_rounds) and scored again: seen steeply, a
-    bulging body's silhouette is wider than the discs under it (each row also shows the ellipses of the discs
-    above and below), so the closed-form profile of the true pitch is drawn too wide and left out of the basin
-    with the lip it shows. Level photographs keep their candidates: their steep ones show no strong lip.
+    """The candidates outside the outline's basin (or the top edge's, config.cue_basin_px) whose lip is strong
+    enough to pick (plain or relative), with their profiles' widths corrected (correct_widths,
+    config.lip_width_rounds) and scored again: seen steeply, a bulging body's silhouette is wider than the discs
+    under it (each row also shows the ellipses of the discs above and below), so the closed-form profile of the
+    true pitch is drawn too wide, its rim too, and left out of the basins with the lip it shows. Level
+    photographs keep their candidates: their steep ones show no strong lip.
 
     Args:
         shapes: (radius B x L, height B, pose B x 4) of the candidates; scores: (outline + bending B, top-edge
@@ -203,7 +206,10 @@ def _second_look(target: Outline, size: int, shapes: tuple[torch.Tensor, torch.T
     strong = contrast > config.lip_contrast
     if config.lip_relative is not None:
         strong = strong | (relative > config.lip_relative)
-    redo = torch.nonzero(strong & (score > score.min() + config.basin)).flatten()
+    outside = score > score.min() + config.basin
+    if config.cue_basin_px is not None:
+        outside = outside | (scores[1] > scores[1].min() + config.cue_basin_px)
+    redo = torch.nonzero(strong & outside).flatten()
     if not len(redo) or config.lip_width_rounds < 1:
         return shapes, scores
     radius, height, pose = shapes

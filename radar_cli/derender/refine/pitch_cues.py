@@ -18,18 +18,20 @@ from radar_cli.sor.solid import Solid
 
 
 def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
-                 offset_px: float, camera: CameraConfig, samples: int = 512) -> tuple[torch.Tensor, torch.Tensor]:
+                 offset_px: float, camera: CameraConfig, samples: int = 512
+                 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """B contrasts of the rim's front arc: the mean grey level just below it (outer wall) minus just above it
     (the inside, seen through the mouth), over the middle 80% of the arc, where both sides lie on the object;
-    and the mean grey level of both sides there.
+    the mean grey level of both sides there; and the share of those samples where the side above is the darker
+    (a mouth's inside is darker along the whole arc; a pattern or an edge that an arc crosses is not).
 
     Args:
         grey: 1 x 2 x S x S: the grey image in [0, 1] and the object's coverage. radius: B x L; height: B;
             pose: B x 4.
 
     Returns:
-        (B contrasts, B levels), both 0 where the rim's ellipse has no width, i.e. seen edge on, or where less
-        than half of the arc's samples lie on the object.
+        (B contrasts, B levels, B shares), all 0 where the rim's ellipse has no width, i.e. seen edge on, or
+        where less than half of the arc's samples lie on the object.
     """
     q = disc_conics(Solid(radius, height, pose), 2, camera)[:, 0]  # B x 3 x 3, the top disc
     x = torch.linspace(-1, 1, samples, dtype=torch.float64)
@@ -50,8 +52,9 @@ def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor,
     level = (values[:, 0, 1] + values[:, 0, 0]).double() / 2 * on_object
     enough = on_object.sum(1) >= 0.5 * use.sum(1).clamp_min(1)
     count = on_object.sum(1).clamp_min(1)
+    share = ((diff > 0) & on_object).sum(1) / count
     zero = torch.zeros_like(diff[:, 0])
-    return torch.where(enough, diff.sum(1) / count, zero), torch.where(enough, level.sum(1) / count, zero)
+    return tuple(torch.where(enough, t, zero) for t in (diff.sum(1) / count, level.sum(1) / count, share))
 
 
 def top_error(model: Outline, target: Outline) -> torch.Tensor:

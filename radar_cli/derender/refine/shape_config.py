@@ -42,8 +42,11 @@ class ShapeFitConfig:
             outline picks among them.
         lip_relative: without a lip above lip_contrast, one whose contrast divided by its two sides' mean grey
             level (plus lip_dark) exceeds this is trusted (a black mouth over a dark neck: a faint edge, but
-            the mouth is several times darker; None: not looked for). Kraters' rims under a black or
-            decorated neck read at most 0.38, steep synthetic vases with a dark neck 0.6-1.1.
+            the mouth is several times darker; None: not looked for), on an arc at least lip_share of which
+            is darker above than below. Steep synthetic vases with a dark neck read 0.36-1.7 with shares of
+            0.93-1.0; the arcs of steep candidates on level photographs of kraters up to 0.50, with shares of
+            at most 0.85 (a decorated neck or rim crosses them).
+        lip_share: see lip_relative.
         lip_dark: grey level added to the sides' mean before dividing (two black sides make no lip).
         dark_lip_bands: the relative lip picks only among candidates whose painted bands' coherence is at least
             this share of the basin's highest (bands too faint to pick still say which pitches they rule out:
@@ -51,8 +54,9 @@ class ShapeFitConfig:
         lip_offset_px, fine_lip_offset_px: the lip's two sides are sampled this far above and below the arc (px
             at 512 px), on the coarse grid (wide: finds the lip) and on the fine one (narrow: places it).
         width_rounds: rounds of correct_widths at full resolution after the search.
-        lip_width_rounds: rounds of correct_widths for the search's candidates outside the basin that show a
-            strong lip, before they are scored again (fit_shape._second_look; 0: none).
+        lip_width_rounds: rounds of correct_widths for the search's candidates outside the basin (or the top
+            edge's, cue_basin_px) that show a strong lip, before they are scored again (fit_shape._second_look;
+            0: none).
         polish_steps: Adam steps at grid_size, then at full resolution, pitch held.
         polish_lr: their step (radii, height and offsets in hundredths of r_max, roll in degrees).
         placement_iterations: closed-form rounds of profile, height and vertical offset per candidate.
@@ -70,7 +74,8 @@ class ShapeFitConfig:
     end_px: float = 2.0
     lip_contrast: float = 0.1
     lip_tie: float = 0.9
-    lip_relative: float | None = 0.5
+    lip_relative: float | None = 0.35
+    lip_share: float = 0.9
     lip_dark: float = 0.02
     dark_lip_bands: float | None = 0.6
     prior_reach: float = 3.0
