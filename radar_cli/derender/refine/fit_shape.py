@@ -24,6 +24,7 @@ import torch.nn.functional as F
 from radar_cli.config import CameraConfig
 from radar_cli.derender.refine.adam import Adam
 from radar_cli.derender.refine.bands import band_coherence, high_pass
+from radar_cli.derender.refine.hidden_rows import smooth_hidden
 from radar_cli.derender.refine.pitch_cues import lip_contrast, pick_cue, top_error
 from radar_cli.derender.refine.shape_config import ShapeFitConfig
 from radar_cli.sor.outline import Outline, mask_outline, outline, vertical_extent
@@ -302,6 +303,8 @@ def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = Shape
     for level, steps in zip((grid, size), config.polish_steps):
         level_target = coarse_target if level == grid else target
         radius, height, pose = polish(level_target, level, radius, height, pose, steps, config, camera)
+    if config.smooth_hidden:
+        radius = smooth_hidden(radius, height, pose, target, size, camera, outline_score)
     error = float(outline_score(outline(Solid(radius, height, pose), size, camera), target, absolute=True)[0])
     return ShapeFit(radius.float(), height.float(), pose.float(), error, cue)
 

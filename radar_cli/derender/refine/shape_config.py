@@ -60,6 +60,8 @@ class ShapeFitConfig:
         polish_steps: Adam steps at grid_size, then at full resolution, pitch held.
         polish_lr: their step (radii, height and offsets in hundredths of r_max, roll in degrees).
         placement_iterations: closed-form rounds of profile, height and vertical offset per candidate.
+        smooth_hidden: after the polish, the profile's rows that no end of the outline depends on are drawn with
+            the least bending (derender.refine.hidden_rows).
     """
 
     rows: int = 64
@@ -89,3 +91,4 @@ class ShapeFitConfig:
     polish_steps: tuple[int, int] = (40, 10)
     polish_lr: float = 0.05
     placement_iterations: int = 3
+    smooth_hidden: bool = True

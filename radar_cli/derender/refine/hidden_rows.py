@@ -1,0 +1,74 @@
+"""Profile rows the photograph does not show, drawn smooth (derender.refine.fit_shape; docs/refinement.md).
+
+Seen from above, a vase's neck lies behind its rim and shoulder: no row or column of the silhouette ends on the
+neck's discs, so the outline neither pulls nor holds those rows of the profile. The row-by-row width correction
+and the polish, whose bending term charges a corner only once, leave them rippled, and the ripples show as rings
+in the normals and every relit view. Here each interior run of rows that no end of the outline depends on is
+replaced by the least-bending curve through the rows around it, and kept only if the outline stays as good.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+from radar_cli.config import CameraConfig
+from radar_cli.sor.outline import Outline, outline
+from radar_cli.sor.solid import Solid
+
+HIDDEN_GRADIENT = 1e-9
+"""A row is hidden where the outline's ends move by less than this per unit of its radius."""
+
+
+def hidden_rows(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, size: int,
+                camera: CameraConfig) -> np.ndarray:
+    """L bools: the rows of a 1 x L profile that no end of its S x S outline depends on (one backward pass of
+    the ends weighted at random: a row some end depends on gets a non-zero gradient almost surely)."""
+    r = radius.detach().clone().requires_grad_(True)
+    drawn = outline(Solid(r, height, pose), size, camera)
+    generator = torch.Generator().manual_seed(0)
+    total = sum((torch.nan_to_num(t) * torch.randn(t.shape, generator=generator, dtype=t.dtype)).sum()
+                for t in (drawn.left, drawn.right, drawn.top, drawn.bottom))
+    (grad,) = torch.autograd.grad(total, r)
+    scale = float(grad.abs().max()) or 1.0
+    return (grad[0].abs() <= HIDDEN_GRADIENT * scale).numpy()
+
+
+def least_bending(profile: np.ndarray, free: np.ndarray) -> np.ndarray:
+    """L radii: `profile` with its `free` rows (L bools) replaced by the values that minimise the sum of squared
+    second differences, the other rows held."""
+    rows = len(profile)
+    bend = np.zeros((rows - 2, rows))
+    idx = np.arange(rows - 2)
+    bend[idx, idx], bend[idx, idx + 1], bend[idx, idx + 2] = 1.0, -2.0, 1.0
+    held = ~free
+    solved, *_ = np.linalg.lstsq(bend[:, free], -bend[:, held] @ profile[held], rcond=None)
+    out = profile.copy()
+    out[free] = solved
+    return out
+
+
+def interior(mask: np.ndarray) -> np.ndarray:
+    """The True runs of an L bool mask that neither the first nor the last row belongs to."""
+    out = mask.copy()
+    for run in (range(len(mask)), range(len(mask) - 1, -1, -1)):
+        for i in run:
+            if not mask[i]:
+                break
+            out[i] = False
+    return out
+
+
+def smooth_hidden(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, target: Outline, size: int,
+                  camera: CameraConfig, score, tolerance: float = 0.01) -> torch.Tensor:
+    """The 1 x L profile with its interior hidden rows drawn with the least bending, where that keeps
+    score(drawn outline, target) (a callable giving B scores, lower better) within `tolerance` of the
+    profile's own (a smoothed row can come into view)."""
+    free = interior(hidden_rows(radius, height, pose, size, camera))
+    if not free.any() or free.all():
+        return radius
+    smooth = torch.from_numpy(least_bending(radius[0].detach().numpy(), free))[None].clamp(0.02, 1.0)
+    both = torch.cat([radius.detach(), smooth.to(radius.dtype)])
+    drawn = outline(Solid(both, height.expand(2), pose.expand(2, -1)), size, camera)
+    scores = score(drawn, target)
+    return smooth.to(radius.dtype) if float(scores[1]) <= float(scores[0]) + tolerance else radius
