@@ -79,13 +79,33 @@ def _within(basin: torch.Tensor, values: torch.Tensor) -> torch.Tensor:
     return torch.where(basin, values, torch.full_like(values, -math.inf))
 
 
+def _lip_over_bands(band: int, basin: torch.Tensor, contrast: torch.Tensor, top: torch.Tensor | None,
+                    pitches: torch.Tensor, config: ShapeFitConfig) -> int:
+    """Where the lip is looked for when painted bands peak at candidate `band`: round that peak, unless no lip
+    lies within their reach while a strong one (config.lip_over_bands) elsewhere in the basin draws the
+    photograph's top edge better than the bands' peak does (a few faint dots near the foot make a band; the open
+    mouth's lip says otherwise). A krater's rim seen level shows a lip within its bands' reach or a worse top
+    edge at the lip's pitch."""
+    if top is None or config.lip_over_bands is None:
+        return band
+    reach = (pitches - pitches[band]).abs() <= config.band_reach
+    if float(_within(basin & reach, contrast).max()) > config.lip_contrast:
+        return band
+    lips = _within(basin, contrast)
+    strongest = int(lips.argmax())
+    if float(lips[strongest]) > config.lip_over_bands and float(top[strongest]) < float(top[band]):
+        return strongest
+    return band
+
+
 def pick_cue(score: torch.Tensor, contrast: torch.Tensor, coherence: torch.Tensor | None, pitches: torch.Tensor,
              config: ShapeFitConfig, top: torch.Tensor | None = None, smooth: torch.Tensor | None = None,
              relative: torch.Tensor | None = None) -> tuple[int, str]:
     """The cue that picks among candidates B (all within the outline's basin, and within config.cue_basin_px
     of the best top edge, `top`, where given):
     - painted bands, where their coherence peaks at least config.band_ratio x its lowest: they bound the lip's
-      search to config.band_reach of their peak (an edge above or below the rim can pass for it);
+      search to config.band_reach of their peak (an edge above or below the rim can pass for it), unless no lip
+      lies there and a strong one elsewhere draws the top edge better (_lip_over_bands);
     - the strongest lip if that lip is strong enough (among near-ties, the best outline with the bending
       uncapped, `smooth`, where given: two arcs as strong, the smoother profile);
     - else, the same way, the strongest lip relative to its sides' grey level (`relative`, B, where given) if
@@ -100,7 +120,8 @@ def pick_cue(score: torch.Tensor, contrast: torch.Tensor, coherence: torch.Tenso
         peaks = _within(basin, coherence)
         if float(peaks.max()) > config.band_ratio * max(float(coherence.min()), 1e-9):
             band = int(peaks.argmax())
-            basin = basin & ((pitches - pitches[band]).abs() <= config.band_reach)
+            centre = _lip_over_bands(band, basin, contrast, top, pitches, config)
+            basin = basin & ((pitches - pitches[centre]).abs() <= config.band_reach)
     tie = score if smooth is None else smooth
     lips = _within(basin, contrast)
     if float(lips.max()) > config.lip_contrast:

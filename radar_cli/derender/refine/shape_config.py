@@ -34,6 +34,9 @@ class ShapeFitConfig:
         band_ratio: painted bands pick the pitch where their coherence peaks at least this many times its lowest
             over the grid.
         band_reach: where they do, the lip is looked for within this of their peak (degrees).
+        lip_over_bands: a lip above this contrast outside the bands' reach is looked at instead where no lip
+            (lip_contrast) lies within their reach and its top edge is the better (pitch_cues._lip_over_bands;
+            None: the bands always bound the lip).
         bands: how the bands are read (derender.refine.bands).
         prior_reach: without bands or a lip, the outline's pick stays at most this above the network's pitch (degrees);
             below it the outline is free (the network reads low pitches too high; a thick rim or a bevelled foot
@@ -83,6 +86,7 @@ class ShapeFitConfig:
     prior_reach: float = 3.0
     band_ratio: float = 8.0
     band_reach: float = 1.0
+    lip_over_bands: float | None = 0.25
     bands: BandCue = BandCue()
     lip_offset_px: float = 2.0
     fine_lip_offset_px: float = 1.0
