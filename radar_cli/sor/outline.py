@@ -16,6 +16,7 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig
+from radar_cli.sor.conic_lines import band, crossings, disc_winners, flat_lines, line_spans, roots, winner
 from radar_cli.sor.pose import rotation_matrix, translation
 from radar_cli.sor.profile import radius_at
 from radar_cli.sor.solid import Solid
@@ -143,8 +144,8 @@ def _row_ends(q: torch.Tensor, lines: tuple[float, float, int]) -> tuple[torch.T
     Two parts, each exact where the other is not: the ellipses' own crossings of each line (the caps' arcs), and
     the polylines through consecutive ellipses' leftmost and rightmost points (the side contour; a disc seen
     almost edge-on is a thin line that most rows fall between). Each ellipse and each segment is evaluated, without
-    gradients, only on the lines its height range spans (_band), so the cost follows the area the parts cover,
-    not K x N; then each line's winner is evaluated again, so the gradient's graph holds N values, not K x W.
+    gradients, only on the lines its height range spans (conic_lines), so the cost follows the area the parts
+    cover, not K x N; then each line's winner is evaluated again, so the gradient's graph holds N values, not K x W.
 
     Args:
         q: B x K x 3 x 3 conics, discs in order along the axis. lines: (y0, dy, N): the line heights
@@ -162,33 +163,25 @@ def _row_ends(q: torch.Tensor, lines: tuple[float, float, int]) -> tuple[torch.T
     sides = ((xa, a * xa + b), (xb, a * xb + b))
     y0, dy, n = lines
     with torch.no_grad():
-        index, y = _band(*_tangent_heights(_adjugate(q)), lines)  # B x K x W
-        crossings = _crossings(tuple(c[..., None] for c in conic), y)  # (lo, hi), B x K x W each
+        discs = disc_winners(conic, *_tangent_heights(_adjugate(q)), (xa, xb), lines)  # (left, right), B x N
         segments = []
-        for x, ys in sides:
-            seg_index, at = _band(ys[:, :-1], ys[:, 1:], lines)  # B x (K-1) x W
-            segments.append((_segment(x[:, :-1, None], x[:, 1:, None], ys[:, :-1, None], ys[:, 1:, None], at),
-                             seg_index))
-        winners = [(_winner(crossings[i], index, n, reduce), _winner(*segments[i], n, reduce))
-                   for i, reduce in enumerate(("amin", "amax"))]
+        for i, (x, ys) in enumerate(sides):
+            seg_index, at = band(*line_spans(ys[:, :-1], ys[:, 1:], lines), lines)  # B x (K-1) x W
+            values = _segment(x[:, :-1, None], x[:, 1:, None], ys[:, :-1, None], ys[:, 1:, None], at)
+            segments.append(winner(values.flatten(), *flat_lines(seg_index, n), q.shape[0], n, ("amin", "amax")[i],
+                                   q.shape[1] - 1))
+        winners = list(zip(discs, segments))
     heights = y0 + torch.arange(n, device=q.device).to(q.dtype) * dy  # N
     ends = []
     for i, ((disc, segment), (x, ys)) in enumerate(zip(winners, sides)):
         k = disc.clamp(max=q.shape[1] - 1)
-        crossing = _crossings(tuple(c.gather(1, k) for c in conic), heights[None])[i]
+        crossing = crossings(tuple(c.gather(1, k) for c in conic), heights[None])[i]
         crossing = torch.where(disc < q.shape[1], crossing, torch.full_like(crossing, math.nan))
         k = segment.clamp(max=q.shape[1] - 2)
         side = _segment(x.gather(1, k), x.gather(1, k + 1), ys.gather(1, k), ys.gather(1, k + 1), heights[None])
         side = torch.where(segment < q.shape[1] - 1, side, torch.full_like(side, math.nan))
         ends.append(torch.fmin(crossing, side) if i == 0 else torch.fmax(crossing, side))
     return ends[0], ends[1]
-
-
-def _crossings(conic: tuple[torch.Tensor, ...], y: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-    """The smaller and larger x where the lines at heights y cross ellipses (q00, q01, q02, q11, q12, q22, each
-    broadcasting with y), NaN where they miss."""
-    q00, q01, q02, q11, q12, q22 = conic
-    return roots(q00, q01 * y + q02, q11 * y * y + 2 * q12 * y + q22)
 
 
 def _segment(x0: torch.Tensor, x1: torch.Tensor, y0: torch.Tensor, y1: torch.Tensor, at: torch.Tensor) -> torch.Tensor:
@@ -198,51 +191,6 @@ def _segment(x0: torch.Tensor, x1: torch.Tensor, y0: torch.Tensor, y1: torch.Ten
     w = (at - y0) / torch.where(span.abs() > 1e-12, span, torch.full_like(span, 1e-12))
     inside = (w >= 0) & (w <= 1)
     return torch.where(inside, x0 + w * (x1 - x0), torch.full_like(w, math.nan))
-
-
-def _band(low: torch.Tensor, high: torch.Tensor, lines: tuple[float, float, int]) -> tuple[torch.Tensor,
-                                                                                        torch.Tensor]:
-    """The lines each of B x K height ranges [low, high] spans (NaN: none), one spare either side: indices
-    B x K x W into the N lines (N where the range needs fewer than W: a line past the last, whose values
-    _winner drops) and their heights B x K x W. No gradients."""
-    y0, dy, n = lines
-    a, b = (low - y0) / dy, (high - y0) / dy
-    first = (torch.fmin(a, b).floor() - 1).clamp(0, n)
-    last = (torch.fmax(a, b).ceil() + 1).clamp(-1, n - 1)
-    spans = ~(first.isnan() | last.isnan()) & (last >= first)
-    first = torch.where(spans, first, torch.zeros_like(first)).long()
-    last = torch.where(spans, last, torch.full_like(last, -1.0)).long()
-    width = max(int((last - first).max()) + 1, 1) if bool(spans.any()) else 1
-    index = first[..., None] + torch.arange(width, device=low.device)  # B x K x W
-    index = torch.where(index <= last[..., None], index, torch.full_like(index, n))
-    return index, y0 + index.to(low.dtype) * dy
-
-
-def _winner(values: torch.Tensor, index: torch.Tensor, n: int, reduce: str) -> torch.Tensor:
-    """Per line, which of the K parts holds the min or max (reduce: `amin` or `amax`) of B x K x W values on the
-    lines `index` (NaN and index N ignored): B x N part indices, K where a line has none (the first on a tie)."""
-    fill = math.inf if reduce == "amin" else -math.inf
-    found = ~values.isnan() & (index < n)
-    flat = index.flatten(1)
-    src = torch.where(found, values, torch.full_like(values, fill)).flatten(1)
-    best = torch.full((values.shape[0], n + 1), fill, dtype=values.dtype, device=values.device)
-    best = best.scatter_reduce(1, flat, src, reduce)
-    parts = torch.arange(values.shape[1], device=values.device)[None, :, None].expand_as(index)
-    hit = found.flatten(1) & (src == best.gather(1, flat))
-    part = torch.where(hit, parts.flatten(1), torch.full_like(flat, values.shape[1]))
-    none = torch.full((values.shape[0], n + 1), values.shape[1], dtype=flat.dtype, device=values.device)
-    return none.scatter_reduce(1, flat, part, "amin")[:, :n]
-
-
-def roots(qa: torch.Tensor, qb: torch.Tensor, qc: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-    """The smaller and larger real root of qa t^2 + 2 qb t + qc = 0 (NaN where there is none)."""
-    disc = qb * qb - qa * qc
-    real = (disc > 0) & (qa.abs() > 0)
-    root = torch.sqrt(torch.where(real, disc, torch.ones_like(disc)))
-    inv = 1.0 / torch.where(real, qa, torch.ones_like(qa))
-    t1, t2 = (-qb - root) * inv, (-qb + root) * inv
-    nan = torch.full_like(t1, math.nan)
-    return torch.where(real, torch.minimum(t1, t2), nan), torch.where(real, torch.maximum(t1, t2), nan)
 
 
 def _extreme(values: torch.Tensor, reduce, fill: float) -> torch.Tensor:

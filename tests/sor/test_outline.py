@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 import torch
 
+import radar_cli.sor.conic_lines as conic_lines
 from radar_cli.config import CameraConfig
 from radar_cli.render.raycast import cast_rays
 from radar_cli.sor.outline import mask_outline, outline, vertical_extent
@@ -81,3 +82,29 @@ def test_outline_gradient_matches_finite_differences():
         with torch.no_grad():
             numeric = (loss(theta + step) - loss(theta - step)) / 2e-7
         assert float(theta.grad[i]) == pytest.approx(float(numeric), rel=1e-3, abs=1e-3), i
+
+
+@pytest.mark.parametrize("size", [96, 256])
+def test_sampled_and_grouped_discs_give_the_dense_outline_bit_for_bit(size, monkeypatch):
+    """The discs evaluated in groups of similar band widths, after a sample of them has ruled the others out
+    where it can, pick the same winners as every disc on every line it spans: the same ends and gradients."""
+    gen = torch.Generator().manual_seed(3)
+    y = torch.linspace(1, -1, 40)
+    radius = (0.35 + 0.3 * torch.sin(3.0 * y[None] + torch.rand(6, 1, generator=gen) * 6) ** 2).clamp(0.05, 0.9)
+    pose = torch.stack([torch.linspace(0.0, 45.0, 6), torch.randn(6, generator=gen) * 5,
+                        torch.randn(6, generator=gen) * 0.05, torch.randn(6, generator=gen) * 0.05], 1)
+    height = torch.linspace(0.5, 1.0, 6)
+
+    def ends(sample_min: int):
+        monkeypatch.setattr(conic_lines, "SAMPLE_MIN", sample_min)
+        r = radius.double().requires_grad_(True)
+        drawn = outline(Solid(r, height.double(), pose.double()), size, CameraConfig())
+        values = torch.stack([drawn.left, drawn.right, drawn.top, drawn.bottom])
+        torch.nan_to_num(values * torch.linspace(0.5, 2.0, size, dtype=torch.float64)).sum().backward()
+        top, bottom = vertical_extent(Solid(radius, height, pose), size, CameraConfig())
+        return values.detach(), r.grad, torch.stack([top, bottom])
+
+    grouped, dense = ends(0), ends(10**12)
+    for a, b in zip(grouped, dense):
+        assert torch.equal(torch.nan_to_num(a, nan=-7.0), torch.nan_to_num(b, nan=-7.0))
+    assert grouped[0].isfinite().sum() > 4 * 6 * size // 4  # the solids cover a good part of every image

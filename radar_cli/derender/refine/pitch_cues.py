@@ -13,7 +13,8 @@ import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig
 from radar_cli.derender.refine.shape_config import ShapeFitConfig
-from radar_cli.sor.outline import Outline, disc_conics, roots
+from radar_cli.sor.conic_lines import roots
+from radar_cli.sor.outline import Outline, disc_conics
 from radar_cli.sor.solid import Solid
 
 
