@@ -46,7 +46,7 @@ def band(first: torch.Tensor, last: torch.Tensor, lines: tuple[float, float, int
     """The lines first .. last (B x K, line_spans) as indices B x K x W into the N lines (N where a range needs
     fewer than W: a line past the last, whose values winner drops) and their heights B x K x W."""
     y0, dy, n = lines
-    width = max(int((last - first).max()) + 1, 1)
+    width = max(int((last - first).max()) + 1, 1) if last.numel() else 1
     index = first[..., None] + torch.arange(width, device=first.device)  # B x K x W
     index = torch.where(index <= last[..., None], index, torch.full_like(index, n))
     return index, y0 + index.to(torch.float64) * dy
@@ -85,7 +85,7 @@ def disc_winners(conic: tuple[torch.Tensor, ...], low: torch.Tensor, high: torch
     batch, k = low.shape
     first, last = line_spans(low, high, lines)
     spans = last >= first
-    if first.numel() * (int((last - first).max()) + 1) < SAMPLE_MIN:
+    if not first.numel() or first.numel() * (int((last - first).max()) + 1) < SAMPLE_MIN:
         index, y = band(first, last, lines)
         lo, hi = crossings(tuple(c[..., None] for c in conic), y)
         flat = flat_lines(index, n)
