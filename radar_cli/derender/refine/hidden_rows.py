@@ -9,6 +9,8 @@ replaced by the least-bending curve through the rows around it, and kept only if
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 import torch
 
@@ -27,8 +29,8 @@ def hidden_rows(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, 
     r = radius.detach().clone().requires_grad_(True)
     drawn = outline(Solid(r, height, pose), size, camera)
     generator = torch.Generator().manual_seed(0)
-    total = sum((torch.nan_to_num(t) * torch.randn(t.shape, generator=generator, dtype=t.dtype)).sum()
-                for t in (drawn.left, drawn.right, drawn.top, drawn.bottom))
+    total = torch.stack([(torch.nan_to_num(t) * torch.randn(t.shape, generator=generator, dtype=t.dtype)).sum()
+                         for t in (drawn.left, drawn.right, drawn.top, drawn.bottom)]).sum()
     (grad,) = torch.autograd.grad(total, r)
     scale = float(grad.abs().max()) or 1.0
     return (grad[0].abs() <= HIDDEN_GRADIENT * scale).numpy()
@@ -60,7 +62,8 @@ def interior(mask: np.ndarray) -> np.ndarray:
 
 
 def smooth_hidden(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, target: Outline, size: int,
-                  camera: CameraConfig, score, tolerance: float = 0.01) -> torch.Tensor:
+                  camera: CameraConfig, score: Callable[[Outline, Outline], torch.Tensor],
+                  tolerance: float = 0.01) -> torch.Tensor:
     """The 1 x L profile with its interior hidden rows drawn with the least bending, where that keeps
     score(drawn outline, target) (a callable giving B scores, lower better) within `tolerance` of the
     profile's own (a smoothed row can come into view)."""

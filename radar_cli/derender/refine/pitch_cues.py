@@ -55,7 +55,8 @@ def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor,
     count = on_object.sum(1).clamp_min(1)
     share = ((diff > 0) & on_object).sum(1) / count
     zero = torch.zeros_like(diff[:, 0])
-    return tuple(torch.where(enough, t, zero) for t in (diff.sum(1) / count, level.sum(1) / count, share))
+    return (torch.where(enough, diff.sum(1) / count, zero), torch.where(enough, level.sum(1) / count, zero),
+            torch.where(enough, share, zero))
 
 
 def top_error(model: Outline, target: Outline) -> torch.Tensor:
