@@ -8,7 +8,14 @@ import torch
 
 from radar_cli.config import CameraConfig
 from radar_cli.derender.refine.fit_shape import outline_score
-from radar_cli.derender.refine.hidden_rows import hidden_rows, interior, least_bending, smooth_hidden
+from radar_cli.derender.refine.hidden_rows import (
+    HELD_WEAKLY,
+    hidden_rows,
+    interior,
+    least_bending,
+    row_hold,
+    smooth_hidden,
+)
 from radar_cli.sor.outline import outline
 from radar_cli.sor.solid import Solid
 
@@ -50,3 +57,21 @@ def test_a_neck_seen_from_above_is_hidden_and_smoothed_without_moving_the_outlin
     assert bend(smooth) < 0.2 * bend(radius), (bend(smooth), bend(radius))
     drawn = outline(Solid(smooth, height, pose), 256, CAMERA)
     assert float(outline_score(drawn, target, absolute=True)) < 0.05  # the outline is the same
+
+
+def test_the_loosest_smoothing_that_keeps_the_outline_is_the_one_used():
+    """Weakly held rows are smoothed with the hidden ones where the outline stays; else the hidden ones alone;
+    else nothing (a score callable standing in for the outline's says which candidates keep it)."""
+    radius, height, pose = _necked_vase(25.0, ripple=0.02)
+    hold = row_hold(radius, height, pose, 256, CAMERA)
+    loose, strict = (interior(hold <= share) for share in HELD_WEAKLY)
+    assert loose.sum() > strict.sum() > 0
+    profile = radius[0].numpy()
+
+    def pick(verdicts: list[float]) -> np.ndarray:
+        keep = lambda drawn, target: torch.tensor(verdicts, dtype=torch.float64)  # noqa: E731
+        return smooth_hidden(radius, height, pose, None, 256, CAMERA, keep)[0].numpy()
+
+    assert np.allclose(pick([0.0, 0.0, 0.0]), least_bending(profile, loose).clip(0.02, 1.0))
+    assert np.allclose(pick([0.0, 1.0, 0.0]), least_bending(profile, strict).clip(0.02, 1.0))
+    assert np.allclose(pick([0.0, 1.0, 1.0]), profile)

@@ -3,8 +3,9 @@
 Seen from above, a vase's neck lies behind its rim and shoulder: no row or column of the silhouette ends on the
 neck's discs, so the outline neither pulls nor holds those rows of the profile. The row-by-row width correction
 and the polish, whose bending term charges a corner only once, leave them rippled, and the ripples show as rings
-in the normals and every relit view. Here each interior run of rows that no end of the outline depends on is
-replaced by the least-bending curve through the rows around it, and kept only if the outline stays as good.
+in the normals and every relit view; rows the outline holds only by a pixel of a limb ripple the same way. Here
+each interior run of such rows is replaced by the least-bending curve through the rows around it, and kept only
+if the outline stays as good.
 """
 
 from __future__ import annotations
@@ -18,22 +19,30 @@ from radar_cli.config import CameraConfig
 from radar_cli.sor.outline import Outline, outline
 from radar_cli.sor.solid import Solid
 
-HIDDEN_GRADIENT = 1e-9
-"""A row is hidden where the outline's ends move by less than this per unit of its radius."""
+HELD_WEAKLY = (1e-2, 1e-9)
+"""Rows whose outline gradient is at most this share of the profile's largest, loosest first: rows the outline
+holds only weakly (a ring of the shoulder seen from above, its limb one pixel of the outline) and rows it does not
+hold at all. The loosest set whose smoothing keeps the outline is used."""
 
 
-def hidden_rows(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, size: int,
-                camera: CameraConfig) -> np.ndarray:
-    """L bools: the rows of a 1 x L profile that no end of its S x S outline depends on (one backward pass of
-    the ends weighted at random: a row some end depends on gets a non-zero gradient almost surely)."""
+def row_hold(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, size: int,
+             camera: CameraConfig) -> np.ndarray:
+    """L shares: how strongly the S x S outline's ends depend on each row of a 1 x L profile, against the row
+    they depend on most (one backward pass of the ends weighted at random: a row some end depends on gets a
+    non-zero gradient almost surely; 0: no end depends on it)."""
     r = radius.detach().clone().requires_grad_(True)
     drawn = outline(Solid(r, height, pose), size, camera)
     generator = torch.Generator().manual_seed(0)
     total = torch.stack([(torch.nan_to_num(t) * torch.randn(t.shape, generator=generator, dtype=t.dtype)).sum()
                          for t in (drawn.left, drawn.right, drawn.top, drawn.bottom)]).sum()
     (grad,) = torch.autograd.grad(total, r)
-    scale = float(grad.abs().max()) or 1.0
-    return (grad[0].abs() <= HIDDEN_GRADIENT * scale).numpy()
+    return (grad[0].abs() / (float(grad.abs().max()) or 1.0)).numpy()
+
+
+def hidden_rows(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, size: int,
+                camera: CameraConfig) -> np.ndarray:
+    """L bools: the rows of a 1 x L profile that no end of its S x S outline depends on."""
+    return row_hold(radius, height, pose, size, camera) <= HELD_WEAKLY[-1]
 
 
 def least_bending(profile: np.ndarray, free: np.ndarray) -> np.ndarray:
@@ -64,14 +73,19 @@ def interior(mask: np.ndarray) -> np.ndarray:
 def smooth_hidden(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, target: Outline, size: int,
                   camera: CameraConfig, score: Callable[[Outline, Outline], torch.Tensor],
                   tolerance: float = 0.01) -> torch.Tensor:
-    """The 1 x L profile with its interior hidden rows drawn with the least bending, where that keeps
-    score(drawn outline, target) (a callable giving B scores, lower better) within `tolerance` of the
-    profile's own (a smoothed row can come into view)."""
-    free = interior(hidden_rows(radius, height, pose, size, camera))
-    if not free.any() or free.all():
+    """The 1 x L profile with its interior weakly held or hidden rows (HELD_WEAKLY, loosest first) drawn with the
+    least bending, the first such profile that keeps score(drawn outline, target) (a callable giving B scores,
+    lower better) within `tolerance` of the profile's own (a smoothed row can come into view); else the profile."""
+    hold = row_hold(radius, height, pose, size, camera)
+    profile = radius[0].detach().numpy()
+    frees = [interior(hold <= share) for share in HELD_WEAKLY]
+    smooth = [torch.from_numpy(least_bending(profile, free)).clamp(0.02, 1.0) for free in frees if free.any()]
+    if not smooth:
         return radius
-    smooth = torch.from_numpy(least_bending(radius[0].detach().numpy(), free))[None].clamp(0.02, 1.0)
-    both = torch.cat([radius.detach(), smooth.to(radius.dtype)])
-    drawn = outline(Solid(both, height.expand(2), pose.expand(2, -1)), size, camera)
+    both = torch.cat([radius.detach(), torch.stack(smooth).to(radius.dtype)])  # (1 + C) x L
+    drawn = outline(Solid(both, height.expand(len(both)), pose.expand(len(both), -1)), size, camera)
     scores = score(drawn, target)
-    return smooth.to(radius.dtype) if float(scores[1]) <= float(scores[0]) + tolerance else radius
+    for k in range(1, len(both)):
+        if float(scores[k]) <= float(scores[0]) + tolerance:
+            return both[k : k + 1]
+    return radius
