@@ -78,8 +78,12 @@ def smooth_hidden(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor
     lower better) within `tolerance` of the profile's own (a smoothed row can come into view); else the profile."""
     hold = row_hold(radius, height, pose, size, camera)
     profile = radius[0].detach().numpy()
-    frees = [interior(hold <= share) for share in HELD_WEAKLY]
-    smooth = [torch.from_numpy(least_bending(profile, free)).clamp(0.02, 1.0) for free in frees if free.any()]
+    frees: list[np.ndarray] = []
+    for share in HELD_WEAKLY:
+        free = interior(hold <= share)
+        if free.any() and not any(np.array_equal(free, f) for f in frees):
+            frees.append(free)
+    smooth = [torch.from_numpy(least_bending(profile, free)).clamp(0.02, 1.0) for free in frees]
     if not smooth:
         return radius
     both = torch.cat([radius.detach(), torch.stack(smooth).to(radius.dtype)])  # (1 + C) x L
