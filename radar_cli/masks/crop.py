@@ -70,18 +70,29 @@ def outside_mask(crop: CropBox, image_shape: tuple[int, ...], size: int) -> np.n
     return out
 
 
-def cut_edges(mask: np.ndarray, region: tuple[int, int, int, int], min_run: float = 0.02) -> tuple[str, ...]:
-    """The photo edges (`top`, `bottom`, `left`, `right`) that cut the object: where the bool crop mask runs
-    along the edge of `region` (u0, v0, u1, v1: the crop's real photo pixels) for at least `min_run` of the
-    crop's side. A crop framed around the whole object never reaches its own edges, so an edge of the region
-    that the object touches is the photo's."""
-    u0, v0, u1, v1 = region
+def cut_edges(mask: np.ndarray, crop: CropBox, image_shape: tuple[int, ...], min_run: float = 0.02,
+              band: float = 0.01) -> tuple[str, ...]:
+    """The photo edges (`top`, `bottom`, `left`, `right`) that cut the object: where the bool crop mask comes
+    within `band` of the crop's side of an edge of the photo along at least `min_run` of the crop's side. Only
+    the photo's own edges count: an edge of the crop inside the photo (a crop framed round the symmetric core,
+    with handles rising above it) cuts the crop, not the object as photographed.
+
+    Args:
+        mask: S x S bool located object in the crop. crop: its window of the photo. image_shape: the photo's.
+    """
+    size = mask.shape[0]
+    h, w = image_shape[:2]
+    u0, v0, u1, v1 = valid_region(crop, image_shape, size)
     if u1 - u0 < 2 or v1 - v0 < 2:
         return ()
     inner = mask[v0:v1, u0:u1]
-    need = max(1, int(min_run * mask.shape[0]))
-    lines = {"top": inner[0], "bottom": inner[-1], "left": inner[:, 0], "right": inner[:, -1]}
-    return tuple(name for name, line in lines.items() if int(line.sum()) >= need)
+    reach = max(1, int(round(band * size)))
+    need = max(1, int(min_run * size))
+    lines = {"top": (crop.y0 <= 0, inner[:reach].any(0)),
+             "bottom": (crop.y0 + crop.side >= h, inner[-reach:].any(0)),
+             "left": (crop.x0 <= 0, inner[:, :reach].any(1)),
+             "right": (crop.x0 + crop.side >= w, inner[:, -reach:].any(1))}
+    return tuple(name for name, (edge, line) in lines.items() if edge and int(line.sum()) >= need)
 
 
 def crop_affine(crop: CropBox, size: int, scale: float = 1.0) -> np.ndarray:

@@ -12,7 +12,7 @@ import numpy as np
 
 from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
-from radar_cli.masks.appendages import Core, find_axis, symmetric_core, upright_rotation
+from radar_cli.masks.appendages import Core, above_rim, find_axis, symmetric_core, upright_rotation
 from radar_cli.masks.border import frame_inset
 from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fit_backdrop
 from radar_cli.masks.neighbours import base_off_axis, cut_behind, split_neighbour
@@ -54,6 +54,8 @@ class Located:
         neighbour_removed: whether a neighbouring object merged into the vessel was cut off.
         base_off_axis: share of the lowest rows of the located object off its symmetric core (a neighbour
             probably kept with it where large; `neighbours.base_off_axis`).
+        above_rim: what of the object stands above its rim over the mouth, left out of the core (a lid's head,
+            a stopper, flowers; `appendages.above_rim`): its area over the core's, its rise over the rim's width.
     """
 
     image: np.ndarray
@@ -66,6 +68,7 @@ class Located:
     stand_removed: bool = False
     neighbour_removed: bool = False
     base_off_axis: float = 0.0
+    above_rim: tuple[float, float] = (0.0, 0.0)
 
     @property
     def appendage_fraction(self) -> float:
@@ -237,9 +240,8 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     split: Core = symmetric_core(mask)
     final, image, core = refined.framed(rgb, split.core, settings, fill=255)  # beyond the frame: white
     _, _, whole = refined.framed(rgb, mask, settings, box_mask=split.core)
-    region = crops.valid_region(final, rgb.shape, size)
     k = refined.window.side / mask.shape[0]
     coverage = float(mask.sum() * k * k / (rgb.shape[0] * rgb.shape[1]))
     box = crops.CropBox(final.x0 + left, final.y0 + top, final.side)  # in the photo with its frame
-    return Located(image, core, whole & ~core, box, crops.cut_edges(whole, region), min(1.0, coverage),
-                   split.symmetry, stand, neighbour, base_off_axis(mask, split.core))
+    return Located(image, core, whole & ~core, box, crops.cut_edges(whole, final, rgb.shape), min(1.0, coverage),
+                   split.symmetry, stand, neighbour, base_off_axis(mask, split.core), above_rim(mask, split.core))

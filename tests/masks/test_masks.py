@@ -173,3 +173,15 @@ def test_big_jpeg_is_draft_decoded_and_box_is_in_original_pixels(tmp_path):
     (found,) = process_photo(tmp_path / "big.jpg", Settings())
     x0, y0, side = found.original_box()
     assert abs(side - 1200 / 0.85) < 30 and abs(x0 + side / 2 - 1600) < 15 and abs(y0 + side / 2 - 1200) < 15
+
+
+def test_cut_edges_are_the_photos_own_edges() -> None:
+    """An object touching the photo's top (within 1 % of the crop) is cut there; one reaching past a crop edge
+    that lies inside the photo (a handle rising above a crop framed round the core) is not."""
+    mask = np.zeros((200, 200), bool)
+    mask[41:180, 60:140] = True  # 1 px below the photo's top, which is row 40 of the crop
+    assert crops.cut_edges(mask, crops.CropBox(0, -40, 200), (400, 400)) == ("top",)
+    mask[:41, 90:110] = True  # up to the crop's top, which lies inside the photo: the crop's own edge
+    assert crops.cut_edges(mask, crops.CropBox(50, 50, 200), (400, 400)) == ()
+    full = np.ones((200, 200), bool)
+    assert set(crops.cut_edges(full, crops.CropBox(0, 0, 200), (200, 200))) == {"top", "bottom", "left", "right"}

@@ -1,11 +1,13 @@
 """The whole-object scores of masks.quality: how far a solid's outline is off a silhouette, how round a
-silhouette is, how uneven or jagged its lower outline is, whether its top closes in a dome."""
+silhouette is, how uneven or jagged its lower outline is, whether its top closes in a dome, how much of it
+stands on the rim left out of the core."""
 
 from __future__ import annotations
 
 import cv2
 import numpy as np
 
+from radar_cli.masks.appendages import above_rim
 from radar_cli.masks.quality import edge_roughness, foot_asymmetry, outline_residual, roundness, top_dome
 
 
@@ -106,3 +108,19 @@ def test_a_head_on_a_neck_is_a_dome_and_an_open_mouth_is_not() -> None:
     assert top_dome(_flask("head", 1.25)) > 0.16
     assert top_dome(_flask("head", 0.6)) < 0.1
     assert top_dome(_vase()) == 0.0  # no neck: the widest rows are the body's
+
+
+def test_what_stands_on_the_rim_is_measured_against_the_vessel() -> None:
+    """A head on a lid, left out of the core, is a large share of the vessel above its rim; a thin handle's top
+    rising above the rim is a small one; a plain vessel has none."""
+    core = np.zeros((200, 200), bool)
+    core[80:190, 60:140] = True  # the vessel, its rim at row 80
+    head = core.astype(np.uint8)
+    cv2.circle(head, (105, 55), 28, 1, -1)
+    share, rise = above_rim(head > 0, core)
+    assert share > 0.12 and abs(rise - 53 / 80) < 0.02  # the circle's top at row 27: 53 rows over an 80 px rim
+    handle = core.copy()
+    handle[65:80, 62:70] = True  # a volute's end, thin, at the rim's end
+    share, rise = above_rim(handle, core)
+    assert 0 < share < 0.03 and abs(rise - 15 / 80) < 0.01
+    assert above_rim(core, core) == (0.0, 0.0)

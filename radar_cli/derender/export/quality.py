@@ -89,6 +89,14 @@ class QualityLimits:
     review_base_off_axis: float = 0.1
     """More than this share of the located object's lowest rows off its symmetric core (`base_off_axis`):
     review (a neighbouring object, or a card in front of the foot, probably kept with it)."""
+    review_above_rim: float = 0.08
+    """More of the object than this (its area over the core's) standing above its rim over the mouth, left out of
+    the solid (`above_rim`): review (a lid's head, a stopper, a figure or flowers)."""
+    review_above_rim_rise: tuple[float, float] = (0.03, 0.3)
+    """... or more than the first (area) rising above the rim by more than the second (of the rim's width,
+    `above_rim_rise`): review. A volute or a handle's plate seen end-on is thin and low."""
+    review_cut_top: bool = True
+    """An object the photo's top edge cuts: review (its rim, and whatever stands on it, is not in the photo)."""
 
 
 def psnr(a: np.ndarray, b: np.ndarray) -> float:
@@ -131,7 +139,9 @@ def scores(prepared: Prepared, rendered: np.ndarray, recon: np.ndarray, mouth: n
             "cut_edges": list(prepared.cut_edges),
             "frame_coverage": _round(prepared.frame_coverage),
             "neighbour_cut": prepared.neighbour_cut,
-            "base_off_axis": _round(prepared.base_off_axis)}
+            "base_off_axis": _round(prepared.base_off_axis),
+            "above_rim": None if prepared.above_rim is None else _round(prepared.above_rim[0]),
+            "above_rim_rise": None if prepared.above_rim is None else _round(prepared.above_rim[1])}
 
 
 def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None, rendered: np.ndarray,
@@ -197,6 +207,8 @@ def judge(record: dict, limits: QualityLimits = QualityLimits()) -> tuple[str, l
     review += likeness_reasons(record, limits)
     if len(record.get("cut_edges", [])) >= limits.review_cut_edges:
         review.append(f"cut by {len(record['cut_edges'])} photo edges")
+    elif limits.review_cut_top and "top" in record.get("cut_edges", []):
+        review.append("the photo's frame cuts off the object's top: its rim, and whatever stands on it, is not seen")
     review += neighbour_reasons(record, limits)
     if failed:
         return "failed", failed + review
@@ -220,6 +232,10 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
         ("top_dome", lambda v: v > limits.review_dome,
          "the top closes in a dome above a neck ({:.2f} of its width deep), not an open mouth: a head, a stopper "
          "or a lid's knob - is it turned?"),
+        ("above_rim", lambda v: v > limits.review_above_rim or (v > limits.review_above_rim_rise[0] and (
+            record.get("above_rim_rise") or 0) > limits.review_above_rim_rise[1]),
+         "something stands on the rim and is left out of the solid ({:.2f} of the vessel's size): a lid, a "
+         "stopper, a figure or flowers?"),
         ("roundness", lambda v: v >= limits.review_roundness and (record.get("rim_contrast") or 0) >= limits.review_rim,
          "the silhouette is round ({:.2f}), a lit rim round a dark inside: a view from above into the mouth, "
          "not a side view?"),

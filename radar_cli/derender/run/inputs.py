@@ -104,6 +104,9 @@ class Prepared:
         neighbour_cut: whether a neighbouring object merged into the located one was cut away from it.
         base_off_axis: share of the located object's lowest rows off its symmetric core (a neighbour kept
             with it where large); None if not located.
+        above_rim: what of the located object stands above its rim over the mouth, left out of the core (a
+            lid's head, a stopper, flowers): its area over the core's, its rise over the rim's width; None if not
+            located.
     """
 
     image: np.ndarray
@@ -119,6 +122,7 @@ class Prepared:
     photo_scene: np.ndarray | None = None
     neighbour_cut: bool = False
     base_off_axis: float | None = None
+    above_rim: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         if self.photo_image is None:  # frozen: the network's crop is the output crop
@@ -351,7 +355,8 @@ def located_input(photo: np.ndarray, size: int, name: str, backdrop: Backdrop = 
                        photo_silhouette=resize_mask(found.silhouette, side),
                        appendages=resize_mask(found.appendages, side), cut_edges=found.cut_edges,
                        frame_coverage=round(found.frame_coverage, 4), neighbour_cut=found.neighbour_removed,
-                       base_off_axis=round(found.base_off_axis, 4))
+                       base_off_axis=round(found.base_off_axis, 4),
+                       above_rim=(round(found.above_rim[0], 4), round(found.above_rim[1], 4)))
     return _on_backdrop(located, backdrop)
 
 
