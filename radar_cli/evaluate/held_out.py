@@ -2,8 +2,8 @@
 3 side views, each side view in turn is left out; the object is fitted on the others (derender.multiview.fit),
 and the left-out view is drawn at its own fitted shape, pose, turn and lighting (those of the fit on all side
 views: only the albedo comes from the others) with the others' fused albedo, and with the single-view albedo of the
-nearest other view (its frontal third mirrored round, as `radar derender` does for one photo). Both are scored
-against the photograph inside its silhouette."""
+nearest other view (as `radar derender` draws it for that photo alone: its own texels within 75 deg of its view,
+mirrored round beyond). Both are scored against the photograph inside its silhouette."""
 
 from __future__ import annotations
 
@@ -30,9 +30,9 @@ from radar_cli.derender.multiview.fit import (
 from radar_cli.derender.multiview.pictures import draw_view
 from radar_cli.derender.run.inputs import Resolution, collect_inputs
 from radar_cli.derender.run.predictor import Predictor
+from radar_cli.derender.run.upsample import full_resolution_state
 from radar_cli.fileio import write_text
 from radar_cli.render.scene import rotate_full_map
-from radar_cli.render.texture import front_third, full_from_front
 
 MIN_SIDE_VIEWS = 3
 PICTURE_SIDE = 256
@@ -41,7 +41,7 @@ PICTURE_SIDE = 256
 @dataclass(frozen=True)
 class HeldOut:
     """One left-out view's scores (PSNR dB, SSIM) inside its silhouette: the views' fused albedo (`multi`) and the
-    nearest view's mirrored one (`single`)."""
+    nearest view's single-view one (`single`)."""
 
     object: str
     view: str
@@ -80,7 +80,8 @@ def leave_out(views: list[ViewFit], held: ViewFit, full: dict[int, tuple], predi
     held.used = True
     turn, held.appearance = full[id(held)][0] - reference, full[id(held)][1]
     nearest = min(others, key=lambda v: _angle(v.turn, turn))
-    single = rotate_full_map(full_from_front(front_third(nearest.tex.albedo)), nearest.turn)
+    alone = full_resolution_state(nearest.looks, nearest.crops, predictor.setup, "divided")
+    single = rotate_full_map(alone.material.albedo, nearest.turn)
     photo, mask = held.photo, held.mask
     multi_image, single_image = (draw_view(held, albedo, turn, predictor) for albedo in (fit.fused_map.albedo, single))
     score = HeldOut("", Path(held.source).stem, round(turn % 360, 2), Path(nearest.source).stem,

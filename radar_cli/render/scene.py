@@ -136,6 +136,7 @@ def divide_shading(
     camera: CameraConfig,
     silhouette: torch.Tensor | None = None,
     max_specular_share: float = MAX_SPECULAR_SHARE,
+    span: float = FRONT_SPAN,
 ) -> torch.Tensor:
     """The albedo as the image's unwrapped frontal texture divided by the shading of a predicted shape, lighting
     and material (Eq. 5 inverted, lighting.decompose): it keeps the image's detail and draws the image back (up to
@@ -146,17 +147,19 @@ def divide_shading(
         solid: the predicted shape and pose of B objects.
         albedo: B x 3 x Ht x Wt the predicted albedo, the fallback off the object.
         rho: B predicted specular albedo.
-        shading: `shade` of that prediction over the frontal third (the caller usually has it already).
+        shading: `shade` of that prediction over the same span (the caller usually has it already).
         render, camera: the model's settings (texture size, gamma).
         silhouette: B x 1 x S x S object coverage in [0, 1] if known: texels that unwrap from off the object
             (where the predicted outline overhangs the true one) would divide the backdrop, so they keep `albedo`,
             blended by the coverage.
+        span: half-width in radians of the angles unwrapped (default the frontal third; `albedo`, `shading` and
+            render.tex_width cover the same).
 
     Returns:
         B x 3 x Ht x Wt linear albedo in [0, 1].
     """
     stacked = image if silhouette is None else torch.cat([image, silhouette], dim=1)  # B x (3 or 4) x S x S
-    unwrapped = unwrap(solid, stacked, (render.tex_height, render.tex_width), camera)
+    unwrapped = unwrap(solid, stacked, (render.tex_height, render.tex_width), camera, span)
     divided = decompose(unwrapped[:, :3], shading.diffuse, shading.specular, rho, render.gamma, max_specular_share)
     if silhouette is None:
         return divided

@@ -24,11 +24,18 @@ def front_third(texture: torch.Tensor) -> torch.Tensor:
     return texture[..., w : 2 * w]
 
 
-def full_from_front(front: torch.Tensor) -> torch.Tensor:
-    """A 360 deg map from a frontal third by mirroring it onto the sides and back, as the paper does for
-    visualisation: [mirror | front | mirror], B x C x Ht x 3Wt, seamless at both joins."""
-    mirrored = torch.flip(front, dims=[-1])
-    return torch.cat([mirrored, front, mirrored], dim=-1)
+def full_from_front(front: torch.Tensor, third: int | None = None) -> torch.Tensor:
+    """A 360 deg map from a frontal map by mirroring it onto the sides and back: [mirror | front | mirror],
+    B x C x Ht x 3 third, seamless at both joins (the paper mirrors the frontal third so, for visualisation).
+
+    Args:
+        front: B x C x Ht x W: the frontal third (W = third), or a wider frontal map (W = third + 2k) whose
+            columns are the full map's middle ones (the frontal third and k more on each side).
+        third: the columns of a third of the full map; default W.
+    """
+    third = front.shape[-1] if third is None else third
+    side = third - (front.shape[-1] - third) // 2  # columns of each mirrored part
+    return torch.cat([front[..., :side].flip(-1), front, front[..., -side:].flip(-1)], dim=-1)
 
 
 def render_texture(
@@ -80,8 +87,10 @@ def unwrap(
     image: torch.Tensor,
     tex_size: tuple[int, int],
     camera: CameraConfig = CameraConfig(),
+    span: float = FRONT_SPAN,
 ) -> torch.Tensor:
-    """Unwrap the frontal third of the surface from an image into texture space (Eq. 4).
+    """Unwrap the frontal third (or the angles within +- span) of the surface from an image into texture space
+    (Eq. 4).
 
     Every texel's surface point is known in closed form; it is projected into the image and sampled bilinearly.
     Differentiable in the image, the shape and the pose.
@@ -99,7 +108,7 @@ def unwrap(
     check_shape(image, "B C H W", "image", {"B": radius.shape[0]})
     check_finite(image, "image")
     rows, cols = tex_size
-    return sample_surface(image, surface_grid(solid, rows, cols, camera), camera)
+    return sample_surface(image, surface_grid(solid, rows, cols, camera, span), camera)
 
 
 def sample_surface(image: torch.Tensor, grid: SurfaceGrid, camera: CameraConfig = CameraConfig()) -> torch.Tensor:

@@ -22,6 +22,7 @@ from radar_cli.derender.run.inputs import InputItem, output_side, prepare
 from radar_cli.derender.run.predictor import ASSETS, Predictor
 from radar_cli.derender.run.upsample import PROFILE_ROWS, full_resolution_state
 from radar_cli.errors import InputError
+from radar_cli.masks import crop as crops
 
 from .conftest import SETUP, SIZE, FakeModel, vase_photo, write_photo
 
@@ -186,3 +187,38 @@ def test_known_mask_is_cut_at_both_sides(tmp_path: Path) -> None:
     assert prepared.photo_silhouette.shape == (96, 96)
     assert prepared.photo_silhouette.mean() == pytest.approx(prepared.silhouette.mean(), abs=0.02)
     assert (prepared.photo_image[~prepared.photo_silhouette] > 230).all()  # the backdrop whitened at N too
+
+
+def test_divided_albedo_keeps_the_photo_beyond_the_frontal_third() -> None:
+    """A vase rendered with a stripe painted 50-58 deg from the view, de-rendered at its own shape, pose and
+    light: the map shows the stripe there and plain paint at 63-67 deg, as the photo does (mirroring the frontal
+    third about 60 deg put a second stripe there: a painted face drawn twice on real photographs)."""
+    import torch
+
+    from radar_cli.derender.run.inputs import Prepared
+    from radar_cli.model.outputs import Decomposition
+    from radar_cli.render.material import Material
+    from radar_cli.render.scene import render_synthetic
+    from radar_cli.sor.solid import Solid
+
+    side, render = 3 * SIDE // 2, SETUP.render
+    phi = (np.arange(3 * side) + 0.5) / (3 * side) * 360 - 180  # each column's angle from the view
+    albedo = torch.full((1, 3, side, 3 * side), 0.8)
+    albedo[:, 1:, :, torch.from_numpy((phi > 50) & (phi < 58))] = 0.1  # red
+    y = torch.linspace(1, -1, 16)
+    solid = Solid((0.6 + 0.15 * torch.cos(2 * y))[None], torch.tensor([0.8]), torch.tensor([[8.0, 0.0, 0.0, 0.0]]))
+    env = torch.full((1, render.env_height, render.env_width), 0.3)
+    material = Material(albedo, env, torch.tensor([20.0]), torch.tensor([0.0]))
+    image, hits, _ = render_synthetic(solid, material, side, render, SETUP.camera, 1.0)
+    photo = (image[0].permute(1, 2, 0).numpy() * 255 + 0.5).astype(np.uint8)
+    mask = hits.mask[0].numpy()
+    small = np.asarray(Image.fromarray(photo).resize((SIZE, SIZE), Image.BILINEAR))
+    prepared = Prepared(small, crops.CropBox(0, 0, side), (side, side),
+                        silhouette=np.asarray(Image.fromarray(mask).resize((SIZE, SIZE))), photo_image=photo,
+                        photo_silhouette=mask)
+    dec = Decomposition(solid.radius, solid.height, solid.pose, torch.full((1, 3, 32, 32), 0.8), env,
+                        material.alpha, material.rho)
+    got = full_resolution_state(dec, prepared, SETUP, "divided").material.albedo[0, :, side // 4 : 3 * side // 4]
+    redness = (got[0] - got[1:].mean(0)).mean(0).numpy()  # per column
+    assert redness[(phi > 51) & (phi < 57)].min() > 0.4  # the stripe, as painted
+    assert np.abs(redness[(phi > 63) & (phi < 67)]).max() < 0.1  # plain, as painted (no mirrored stripe)

@@ -65,13 +65,15 @@ class ObjectState:
                                    shading_width=min(render.shading_width, EXPORT_SHADING_GRID))
 
     @classmethod
-    def from_decomposition(cls, dec: Decomposition, render: RenderConfig, camera: CameraConfig) -> "ObjectState":
-        """The state of a batch-of-one Decomposition; the frontal albedo is mirrored to 360 deg."""
+    def from_decomposition(cls, dec: Decomposition, render: RenderConfig, camera: CameraConfig,
+                           albedo: torch.Tensor | None = None) -> "ObjectState":
+        """The state of a batch-of-one Decomposition: its frontal albedo mirrored to 360 deg, or `albedo` (a 360
+        deg map, 1 x 3 x Ht x 3Wt linear) instead."""
         if dec.radius.shape[0] != 1:
             raise ValueError(f"expected a batch of one, got {dec.radius.shape[0]}")
         export_render = cls.export_render(render)
-        albedo = quantise(full_from_front(dec.albedo.float().clamp(0, 1)), render.gamma)
-        material = dec.material.map(torch.Tensor.float).with_albedo(albedo)
+        whole = full_from_front(dec.albedo.float()) if albedo is None else albedo.float()
+        material = dec.material.map(torch.Tensor.float).with_albedo(quantise(whole.clamp(0, 1), render.gamma))
         return cls(dec.solid.map(torch.Tensor.float), material, export_render, camera)
 
     def record(self) -> dict:
