@@ -189,12 +189,13 @@ def _second_look(target: Outline, size: int, shapes: tuple[torch.Tensor, torch.T
                  scores: tuple[torch.Tensor, torch.Tensor, torch.Tensor], contrast: torch.Tensor,
                  relative: torch.Tensor, config: ShapeFitConfig, camera: CameraConfig
                  ) -> tuple[tuple[torch.Tensor, torch.Tensor, torch.Tensor], tuple[torch.Tensor, ...]]:
-    """The candidates outside the outline's basin (or the top edge's, config.cue_basin_px) whose lip is strong
-    enough to pick (plain or relative), with their profiles' widths corrected (correct_widths,
-    config.lip_width_rounds) and scored again: seen steeply, a bulging body's silhouette is wider than the discs
-    under it (each row also shows the ellipses of the discs above and below), so the closed-form profile of the
-    true pitch is drawn too wide, its rim too, and left out of the basins with the lip it shows. Level
-    photographs keep their candidates: their steep ones show no strong lip.
+    """The candidates whose lip is strong enough to pick (plain or relative), with their profiles' widths
+    corrected (correct_widths, config.lip_width_rounds) and scored again: seen steeply, a bulging body's silhouette
+    is wider than the discs under it (each row also shows the ellipses of the discs above and below), so the
+    closed-form profile of the true pitch is drawn too wide, its rim too, and left out of the basins with the lip
+    it shows, or kept in them with a top edge drawn worse than a painted band's pitch draws it. Level photographs
+    keep their candidates: their steep ones show no strong lip, and their own lips (near level) are drawn as
+    before (the same picks on the 20 krater views and the 12 Met photographs).
 
     Args:
         shapes: (radius B x L, height B, pose B x 4) of the candidates; scores: (outline + bending B, top-edge
@@ -203,14 +204,10 @@ def _second_look(target: Outline, size: int, shapes: tuple[torch.Tensor, torch.T
     Returns:
         The shapes and scores with those candidates' entries replaced (new tensors).
     """
-    score = scores[0]
     strong = contrast > config.lip_contrast
     if config.lip_relative is not None:
         strong = strong | (relative > config.lip_relative)
-    outside = score > score.min() + config.basin
-    if config.cue_basin_px is not None:
-        outside = outside | (scores[1] > scores[1].min() + config.cue_basin_px)
-    redo = torch.nonzero(strong & outside).flatten()
+    redo = torch.nonzero(strong).flatten()
     if not len(redo) or config.lip_width_rounds < 1:
         return shapes, scores
     radius, height, pose = shapes

@@ -82,21 +82,29 @@ def _within(basin: torch.Tensor, values: torch.Tensor) -> torch.Tensor:
 
 
 def _lip_over_bands(band: int, basin: torch.Tensor, contrast: torch.Tensor, top: torch.Tensor | None,
-                    pitches: torch.Tensor, config: ShapeFitConfig) -> int:
+                    pitches: torch.Tensor, config: ShapeFitConfig, relative: torch.Tensor | None = None) -> int:
     """Where the lip is looked for when painted bands peak at candidate `band`: round that peak, unless no lip
-    lies within their reach while a strong one (config.lip_over_bands) elsewhere in the basin draws the
-    photograph's top edge better than the bands' peak does (a few faint dots near the foot make a band; the open
-    mouth's lip says otherwise). A krater's rim seen level shows a lip within its bands' reach or a worse top
-    edge at the lip's pitch."""
+    lies within their reach while a strong one (config.lip_over_bands, or relative to its sides' grey level
+    config.dark_lip_over_bands) elsewhere in the basin draws the photograph's top edge better than the bands'
+    peak does, the best drawn of them (a few faint dots near the foot, a dotted band or a glaze's edge make a
+    band; the open mouth's lip says otherwise). A krater's rim seen level shows a lip within its bands' reach
+    or a worse top edge at the lip's pitch, and no dark lip (pick_cue's `relative` is 0 on arcs a decorated
+    neck crosses)."""
     if top is None or config.lip_over_bands is None:
         return band
     reach = (pitches - pitches[band]).abs() <= config.band_reach
     if float(_within(basin & reach, contrast).max()) > config.lip_contrast:
         return band
-    lips = _within(basin, contrast)
-    strongest = int(lips.argmax())
-    if float(lips[strongest]) > config.lip_over_bands and float(top[strongest]) < float(top[band]):
-        return strongest
+    readings = [(contrast, config.lip_over_bands)]
+    if relative is not None and config.dark_lip_over_bands is not None and config.lip_relative is not None:
+        if float(_within(basin & reach, relative).max()) > config.lip_relative:
+            return band
+        readings.append((relative, config.dark_lip_over_bands))
+    for values, limit in readings:
+        lips = _within(basin, values)
+        qualify = (lips > limit) & (top < top[band])
+        if qualify.any():  # of the strong lips that draw the top edge better, the one that draws it best
+            return int(torch.where(qualify, top, torch.full_like(top, math.inf)).argmin())
     return band
 
 
@@ -122,7 +130,7 @@ def pick_cue(score: torch.Tensor, contrast: torch.Tensor, coherence: torch.Tenso
         peaks = _within(basin, coherence)
         if float(peaks.max()) > config.band_ratio * max(float(coherence.min()), 1e-9):
             band = int(peaks.argmax())
-            centre = _lip_over_bands(band, basin, contrast, top, pitches, config)
+            centre = _lip_over_bands(band, basin, contrast, top, pitches, config, relative)
             basin = basin & ((pitches - pitches[centre]).abs() <= config.band_reach)
     tie = score if smooth is None else smooth
     lips = _within(basin, contrast)

@@ -37,6 +37,10 @@ class ShapeFitConfig:
         lip_over_bands: a lip above this contrast outside the bands' reach is looked at instead where no lip
             (lip_contrast) lies within their reach and its top edge is the better (pitch_cues._lip_over_bands;
             None: the bands always bound the lip).
+        dark_lip_over_bands: the same for a lip relative to its sides' grey level (lip_relative) above this, where
+            no such lip above lip_relative lies within their reach either (a black mouth over a dark neck or a
+            glaze's edge: steep synthetic vases read 0.85-0.97 where dots or a glaze's edge made a band; None:
+            not looked at).
         bands: how the bands are read (derender.refine.bands).
         prior_reach: without bands or a lip, the outline's pick stays at most this above the network's pitch (degrees);
             below it the outline is free (the network reads low pitches too high; a thick rim or a bevelled foot
@@ -87,6 +91,7 @@ class ShapeFitConfig:
     band_ratio: float = 8.0
     band_reach: float = 1.0
     lip_over_bands: float | None = 0.25
+    dark_lip_over_bands: float | None = 0.6
     bands: BandCue = BandCue()
     lip_offset_px: float = 2.0
     fine_lip_offset_px: float = 1.0
