@@ -18,10 +18,11 @@ from radar_cli.sor.solid import Solid
 from radar_cli.sor.surface import FRONT_SPAN, SurfaceGrid, surface_grid
 
 
-def front_third(texture: torch.Tensor) -> torch.Tensor:
-    """The frontal third (B x C x Ht x Wt) of a full 360 deg map (B x C x Ht x 3Wt)."""
+def front_third(texture: torch.Tensor, extra: int = 0) -> torch.Tensor:
+    """The frontal third (B x C x Ht x Wt) of a full 360 deg map (B x C x Ht x 3Wt), with `extra` columns more on
+    each side (B x C x Ht x Wt + 2 extra: full_from_front's wide map)."""
     w = texture.shape[-1] // 3
-    return texture[..., w : 2 * w]
+    return texture[..., w - extra : 2 * w + extra]
 
 
 def full_from_front(front: torch.Tensor, third: int | None = None) -> torch.Tensor:

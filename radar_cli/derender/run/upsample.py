@@ -18,7 +18,7 @@ from radar_cli.model.config import ModelConfig
 from radar_cli.model.outputs import Decomposition
 from radar_cli.render.material import Material
 from radar_cli.render.scene import divide_shading, shade
-from radar_cli.render.texture import full_from_front, sample_surface
+from radar_cli.render.texture import front_third, full_from_front, sample_surface
 from radar_cli.sor.resample import smooth_rows
 from radar_cli.sor.solid import Solid
 from radar_cli.sor.surface import FRONT_SPAN, surface_grid
@@ -117,14 +117,14 @@ def _divided_wide(image: torch.Tensor, coverage: torch.Tensor | None, appendages
     extra = round((SEEN_DEG - third) / (2 * third) * side)  # k
     span = FRONT_SPAN * (side + 2 * extra) / side
     render = dataclasses.replace(setup.render, tex_height=side, tex_width=side + 2 * extra)
-    fallback = full_from_front(front)[..., side - extra : 2 * side + extra]
+    fallback = front_third(full_from_front(front), extra)
     material = Material(fallback, dec.env.float(), dec.alpha.float(), dec.rho.float())
     solid = Solid(dec.radius.float(), dec.height.float(), dec.pose.float())
     shading = shade(solid, material, render, setup.camera, span)
     wide = divide_shading(image, solid, fallback, material.rho, shading, render, setup.camera, coverage, span=span)
     if extra == 0:
         return wide
-    mirrored = full_from_front(wide[..., extra : extra + side])[..., side - extra : 2 * side + extra]
+    mirrored = front_third(full_from_front(wide[..., extra : extra + side]), extra)
     grid = surface_grid(solid, side, side + 2 * extra, setup.camera, span)
     facing = (grid.normals * grid.view).sum(-1)[:, None]  # 1 x 1 x N x N + 2k
     lo, hi = SEEN_FACING
