@@ -31,9 +31,9 @@ SEEN_FACING = (0.15, 0.3)
 second cosine, the frontal third's mirror image where less than the first (a ramp between): grazing texels stretch
 the limb's few pixels, its reflections and the outline's errors over many."""
 SEEN_EDGE = 0.01
-"""... and where the photo's silhouette, shrunk by this share of the side (and kept this far from an appendage
-cut off it, four times as far), covers it: near the outline the solid drawn and the photographed one part, and the
-unwrap reads the backdrop or a handle's root."""
+"""... and where the photo's silhouette, shrunk by this share of the side, covers it at least four times this far
+from an appendage cut off it: near the outline the solid drawn and the photographed one part, and the unwrap reads
+the backdrop or a handle's root."""
 SEEN_GLARE = (0.04, 0.12)
 """... and is not a reflection: a texel brighter than the frontal third's mirror image by white light (every
 channel by at least 60 % of the largest channel's excess) of the first linear amount keeps less of the photo, none
@@ -74,8 +74,8 @@ def full_resolution_state(dec: Decomposition, prepared: Prepared, setup: ModelCo
     - the frontal albedo is N x N: `divided` unwraps the N x N crop and divides it by the shading of the
       Decomposition's shape, pose, lighting and material (render.scene.divide_shading, the shading grid as the
       model's, upsampled), with the Decomposition's albedo resized to N where the surface unwraps from off the
-      silhouette, and keeps the photo's texels up to SEEN_DEG where they can be trusted (_divided_wide,
-      _around); `network` resizes the Decomposition's albedo.
+      silhouette, and keeps the photo's texels up to SEEN_DEG where they can be trusted (_divided_albedo);
+      `network` resizes the Decomposition's albedo.
 
     Args:
         dec: batch of one, CPU (radius 1 x L, albedo 1 x 3 x Ht x Wt frontal, ...).
@@ -95,16 +95,17 @@ def full_resolution_state(dec: Decomposition, prepared: Prepared, setup: ModelCo
     if albedo_source == "network":
         return ObjectState.from_decomposition(dec, setup.render, setup.camera)
     image, coverage = photo_tensors(prepared)
-    albedo = _around(_divided_wide(image, coverage, prepared.appendages, dec, front, setup), side)
+    albedo = _divided_albedo(image, coverage, prepared.appendages, dec, front, setup)
     return ObjectState.from_decomposition(dec, setup.render, setup.camera, albedo)
 
 
-def _divided_wide(image: torch.Tensor, coverage: torch.Tensor | None, appendages: np.ndarray | None,
-                  dec: Decomposition, front: torch.Tensor, setup: ModelConfig) -> torch.Tensor:
-    """The divided albedo within SEEN_DEG of the view: 1 x 3 x N x N + 2k, the frontal third (N x N) and k
-    columns more on each side (render.texture.full_from_front's wide map). Beyond the frontal third each texel is
-    the photo's where it is seen squarely enough and well inside the silhouette (SEEN_FACING, SEEN_EDGE), else
-    the frontal third's mirror image.
+def _divided_albedo(image: torch.Tensor, coverage: torch.Tensor | None, appendages: np.ndarray | None,
+                    dec: Decomposition, front: torch.Tensor, setup: ModelConfig) -> torch.Tensor:
+    """The 360 deg divided albedo, 1 x 3 x N x 3N: the photo divided by the shading within SEEN_DEG of the view
+    (the frontal third, N x N, and k columns more on each side: render.texture.full_from_front's wide map), where
+    beyond the frontal third each texel is the photo's if it is seen squarely enough, well inside the silhouette
+    and no glare (SEEN_FACING, SEEN_EDGE, SEEN_GLARE), else the frontal third's mirror image; round the rest
+    (_around).
 
     Args:
         image: 1 x 3 x N x N tone-mapped crop; coverage: 1 x 1 x N x N silhouette or None; appendages: N x N
@@ -123,8 +124,9 @@ def _divided_wide(image: torch.Tensor, coverage: torch.Tensor | None, appendages
     shading = shade(solid, material, render, setup.camera, span)
     wide = divide_shading(image, solid, fallback, material.rho, shading, render, setup.camera, coverage, span=span)
     if extra == 0:
-        return wide
-    mirrored = front_third(full_from_front(wide[..., extra : extra + side]), extra)
+        return full_from_front(wide)
+    sides = full_from_front(wide[..., extra : extra + side])  # the frontal third mirrored round, 1 x 3 x N x 3N
+    mirrored = front_third(sides, extra)
     grid = surface_grid(solid, side, side + 2 * extra, setup.camera, span)
     facing = (grid.normals * grid.view).sum(-1)[:, None]  # 1 x 1 x N x N + 2k
     lo, hi = SEEN_FACING
@@ -142,18 +144,17 @@ def _divided_wide(image: torch.Tensor, coverage: torch.Tensor | None, appendages
     glare = ((white - lo) / (hi - lo)).clamp(0.0, 1.0) * (white >= 0.6 * top)
     trust = trust * (1 - glare)
     trust[..., extra : extra + side] = 1.0  # the frontal third is the photo's, as it always was
-    return trust * wide + (1 - trust) * mirrored
+    return _around(trust * wide + (1 - trust) * mirrored, sides)
 
 
-def _around(wide: torch.Tensor, third: int) -> torch.Tensor:
-    """The 360 deg map (1 x 3 x Ht x 3 third) of a wide frontal map (_divided_wide): the wide map in the middle;
-    beyond it, its mirror image about its edge fading over as many columns as it adds to the frontal third into
-    the frontal third's mirror image (render.texture.full_from_front), which the sides and back show as they
-    always have: the limb's texels (grazing, often a glaze's reflections) are not spread over them."""
+def _around(wide: torch.Tensor, sides: torch.Tensor) -> torch.Tensor:
+    """The 360 deg map (1 x 3 x Ht x 3 third) of a wide frontal map: the wide map in the middle; beyond it, its
+    mirror image about its edge fading over as many columns as it adds to the frontal third into `sides` (the
+    frontal third mirrored round, render.texture.full_from_front), which the sides and back show as they always
+    have: the limb's texels (grazing, often a glaze's reflections) are not spread over them."""
+    third = sides.shape[-1] // 3
     extra = (wide.shape[-1] - third) // 2
-    if extra == 0:
-        return full_from_front(wide)
-    mirror, sides = full_from_front(wide, third), full_from_front(wide[..., extra : extra + third])
+    mirror = full_from_front(wide, third)
     cols = torch.arange(3 * third, dtype=wide.dtype)
     beyond = torch.maximum((third - extra) - cols, cols - (2 * third + extra - 1)).clamp_min(0.0)  # columns past
     fade = (1 - beyond / extra).clamp(0.0, 1.0)
