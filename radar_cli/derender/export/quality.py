@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from radar_cli.derender.export.faces import face_score
 from radar_cli.derender.export.likeness import (
     colour_shift,
     highlight_excess,
@@ -86,6 +87,9 @@ class QualityLimits:
     """More than this share of the object drawn much brighter than the photo: review (invented highlights)."""
     review_colour: float = 15.0
     """The reconstruction's mean chroma further than this from the photo's (CIELAB): review."""
+    review_face: float = 0.0
+    """A face on the object scoring above this (`face`, the face detector's own threshold): review (a head vase,
+    a figure or a lid shaped as a head, which the solid turns into a smooth body)."""
     review_base_off_axis: float = 0.1
     """More than this share of the located object's lowest rows off its symmetric core (`base_off_axis`):
     review (a neighbouring object, or a card in front of the foot, probably kept with it)."""
@@ -170,6 +174,7 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
         "mouth_error": _round(mouth_error(photo, recon, region & rendered, mouth)),
         "highlight_excess": _round(highlight_excess(photo, recon, region & rendered)),
         "colour_shift": _round(colour_shift(photo, recon, region & rendered), 2),
+        "face": None if whole is None else _round(face_score(photo, whole), 3),
         "shading_range": _round(shading_range(profile)),
         "rim_contrast": _round(rim_contrast(profile)),
         "appendage_fraction": (None if app is None or whole is None or not whole.any()
@@ -247,6 +252,9 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
          "the reconstruction has highlights the photo does not have ({:.0%} of the object)"),
         ("colour_shift", lambda v: v > limits.review_colour,
          "the reconstruction's colour is off the photo's ({:.0f})"),
+        ("face", lambda v: v > limits.review_face,
+         "a face looks out of the object (detector score {:.2f}): a head vase, a figure or a lid shaped as a head, "
+         "which the solid turns into a smooth body?"),
     )
     return [words.format(record[key]) for key, bad, words in checks if record.get(key) is not None and bad(record[key])]
 

@@ -17,10 +17,11 @@ SUMMARY_COLUMNS = ("object", "status", "reason", "source", "pitch", "roll", "tx"
                    "roughness", "crop_box", "model", "silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction",
                    "outline_support", "object_symmetry", "outline_residual", "foot_asymmetry", "edge_roughness",
                    "top_dome", "roundness", "rim_contrast", "shading_range", "mouth_error", "highlight_excess",
-                   "colour_shift", "cut_edges", "resolution", "refine", "refine_reason", "refine_iou")
+                   "colour_shift", "face", "cut_edges", "resolution", "refine", "refine_reason", "refine_iou")
 QUALITY_COLUMNS = ("silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction", "outline_support",
                    "object_symmetry", "outline_residual", "foot_asymmetry", "edge_roughness", "top_dome",
-                   "roundness", "rim_contrast", "shading_range", "mouth_error", "highlight_excess", "colour_shift")
+                   "roundness", "rim_contrast", "shading_range", "mouth_error", "highlight_excess", "colour_shift",
+                   "face")
 STATUS_ORDER = {"failed": 0, "review": 1, "ok": 2}  # worst first; objects without a quality record come last
 
 
