@@ -15,7 +15,7 @@ from radar_cli.masks import crop as crops
 from radar_cli.masks.appendages import Core, above_rim, find_axis, symmetric_core, upright_rotation
 from radar_cli.masks.border import frame_inset
 from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fit_backdrop
-from radar_cli.masks.neighbours import base_off_axis, cut_behind, split_neighbour
+from radar_cli.masks.neighbours import base_off_axis, cut_base, cut_behind, split_neighbour
 from radar_cli.masks.pipeline import (
     Refined,
     Settings,
@@ -238,6 +238,8 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
         mask, neighbour = split_neighbour(mask)
     mask, stand = remove_stand(open_gaps(mask, refined.image, refined.outside), refined.image)
     split: Core = symmetric_core(mask)
+    mask, card = cut_base(mask, split.core)
+    neighbour = neighbour or card
     final, image, core = refined.framed(rgb, split.core, settings, fill=255)  # beyond the frame: white
     _, _, whole = refined.framed(rgb, mask, settings, box_mask=split.core)
     k = refined.window.side / mask.shape[0]

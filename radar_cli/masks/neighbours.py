@@ -24,6 +24,9 @@ SECOND_PEAK = 0.3  # a second hump at least this fraction of the main one's heig
 VALLEY = 0.6  # ... when the profile between them drops below this fraction of the second hump
 MIN_PART = 0.05  # ... and the part beyond the valley holds at least this share of the object
 BASE = 0.4  # `base_off_axis` reads this lowest share of the object's rows
+BASE_MERGED = 0.1  # more of those rows than this off the symmetric core: something probably merged at the base
+BASE_CUT_MAX = 0.25  # `cut_base` cuts at most this share of the object ...
+BASE_CUT_GAIN = 0.02  # ... and only where the cut raises the solid-of-revolution score by this much
 
 
 def _valley(profile: np.ndarray, start: int, step: int) -> int | None:
@@ -82,6 +85,30 @@ def base_off_axis(whole: np.ndarray, core: np.ndarray) -> float:
     low = whole.copy()
     low[: rows.max() + 1 - int(BASE * (rows.max() - rows.min() + 1))] = False
     return float((low & ~core).sum() / max(int(low.sum()), 1))
+
+
+def cut_base(whole: np.ndarray, core: np.ndarray) -> tuple[np.ndarray, bool]:
+    """The located object with what stands in front of or beside its foot cut off: where more of its lowest rows
+    than BASE_MERGED lie off its symmetric core (`base_off_axis`), the connected parts off the core that reach
+    into those rows (a card or label in front of the foot, a neighbour beside it) are cut, if they are a small
+    part of the object (BASE_CUT_MAX) and the vessel left is more of a solid of revolution (BASE_CUT_GAIN). A
+    vessel's own foot is symmetric and its handles sit higher.
+
+    Args:
+        whole: n x n bool located object; core: n x n bool, its symmetric core (inside `whole`).
+    Returns:
+        (object, whether anything was cut off).
+    """
+    rows = np.nonzero(whole.any(1))[0]
+    if len(rows) < 2 or base_off_axis(whole, core) <= BASE_MERGED:
+        return whole, False
+    _, labels = cv2.connectedComponents((whole & ~core).astype(np.uint8), connectivity=8)
+    low = np.unique(labels[rows.max() + 1 - int(BASE * (rows.max() - rows.min() + 1)) :])
+    parts = np.isin(labels, low[low > 0])
+    cut = whole & ~parts
+    if parts.sum() > BASE_CUT_MAX * whole.sum() or sor_score(cut) < sor_score(whole) + BASE_CUT_GAIN:
+        return whole, False
+    return cut, True
 
 
 BEHIND_TOLERANCE = 0.03  # a row's midpoint within this fraction of the object's width of the axis is clean

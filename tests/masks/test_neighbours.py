@@ -1,6 +1,7 @@
 """A second vessel standing behind the located one (partly hidden by it, standing higher) is cut off; a lone
 vessel, a one-handled jug, a tilted vessel and a neighbour standing level beside it are left to the rest of the
-locator. The photos and masks are drawn here."""
+locator. A card in front of the foot is cut off the located object; a vessel's own handles are not. The photos and
+masks are drawn here."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 
 from radar_cli.masks import crop as crops
 from radar_cli.masks.locate import locate_object
-from radar_cli.masks.neighbours import cut_behind
+from radar_cli.masks.neighbours import cut_base, cut_behind
 from radar_cli.masks.refine import iou
 
 H, W = 240, 220
@@ -60,3 +61,15 @@ def test_a_vessel_in_front_of_another_is_located_without_it() -> None:
     found = locate_object(photo, 128)
     truth = crops.cut(main.astype(np.float32), found.box, 128, fill=0) > 0.5
     assert found.neighbour_removed and iou(found.silhouette | found.appendages, truth) >= 0.9
+
+
+def test_a_card_in_front_of_the_foot_is_cut_off_and_handles_stay() -> None:
+    main = vessel(100, 20, 200, 120)
+    y, x = np.mgrid[0:H, 0:W]
+    card = (x >= 110) & (x < 200) & (y >= 175) & (y < 215)  # a label standing against the foot's right side
+    cut, removed = cut_base(main | card, main)
+    assert removed and iou(cut, main) >= 0.98
+    ring = ((x - 165) / 22.0) ** 2 + ((y - 85) / 50.0) ** 2
+    handles = main | ((ring <= 1) & (ring >= 0.45) & (x > 140))
+    kept, removed = cut_base(handles, main)
+    assert not removed and (kept == handles).all()

@@ -21,6 +21,7 @@ from radar_cli.derender.export.renders import ViewRenderer
 from radar_cli.derender.run.inputs import Prepared
 from radar_cli.derender.run.state import ObjectState
 from radar_cli.masks.crop import outside_mask
+from radar_cli.masks.neighbours import BASE_MERGED
 from radar_cli.masks.outline import outline_support
 from radar_cli.masks.quality import (
     edge_roughness,
@@ -90,7 +91,7 @@ class QualityLimits:
     review_face: float = 0.0
     """A face on the object scoring above this (`face`, the face detector's own threshold): review (a head vase,
     a figure or a lid shaped as a head, which the solid turns into a smooth body)."""
-    review_base_off_axis: float = 0.1
+    review_base_off_axis: float = BASE_MERGED
     """More than this share of the located object's lowest rows off its symmetric core (`base_off_axis`):
     review (a neighbouring object, or a card in front of the foot, probably kept with it)."""
     review_above_rim: float = 0.08
