@@ -6,8 +6,8 @@ Sources: the real photographs of ../shared/data/real_vases (when present; the re
 located on the original photo) and rendered vases pasted over studio backdrops (the truth is known). Each is
 turned into every `variants.KINDS` framing; the located silhouette (core and appendages) is compared with the
 reference cut by the same crop. Pasted vases also get handles: their located core is compared with the
-handle-free truth. Every variant is then de-rendered at the model's size and its `quality` status is set
-against its silhouette IoU.
+handle-free truth. Every variant is then de-rendered as `radar derender` does (output side 512, `--refine`,
+full by default) and its `quality` status is set against its silhouette IoU.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import cv2
 import numpy as np
 
 from radar_cli.derender.export.quality import assess
+from radar_cli.derender.refine.driver import RefineMode
 from radar_cli.derender.run.inputs import (
     Prepared,
     located_input,
@@ -28,7 +29,7 @@ from radar_cli.derender.run.inputs import (
     whole_photo,
 )
 from radar_cli.derender.run.predictor import Predictor
-from radar_cli.derender.run.state import ObjectState
+from radar_cli.derender.run.upsample import full_resolution_state
 from radar_cli.errors import InputError
 from radar_cli.fileio import read_image, write_image
 from radar_cli.masks import crop as crops
@@ -159,11 +160,12 @@ def add_spoilt(results: Results, items: list[tuple[str, Variant]], size: int) ->
     return spoilt
 
 
-def judge_status(results: Results, items: list[tuple[str, Variant]], batch: int = 16) -> None:
-    """De-render every item as `radar derender` does (bundled model) and record its quality status; spoilt
-    silhouettes (`BROKEN`) are added and judged as well."""
+def judge_status(results: Results, items: list[tuple[str, Variant]], batch: int = 16,
+                 refine: RefineMode = "full") -> None:
+    """De-render every item as `radar derender --refine REFINE` does (bundled model, output side 512) and record
+    its quality status; spoilt silhouettes (`BROKEN`) are added and judged as well."""
 
-    predictor = Predictor.from_checkpoint(device="cpu")
+    predictor = Predictor.from_checkpoint(device="cpu", refine=refine)
     size = predictor.setup.render.image_size
     spoilt = add_spoilt(results, items, size)
     for start in range(0, len(items), batch):
@@ -179,8 +181,10 @@ def judge_status(results: Results, items: list[tuple[str, Variant]], batch: int 
             continue
         dec = predictor.predict([prepared[i].image for i in keys], [prepared[i].silhouette for i in keys])
         for j, i in enumerate(keys):
-            state = ObjectState.from_decomposition(dec.select(j), predictor.setup.render, predictor.setup.camera)
-            quality = assess(prepared[i], state)
+            prep = prepared[i]
+            assert prep.photo_image is not None
+            refined, _ = predictor.refine_object(dec.select(j), prep.image, prep.photo_image, prep.photo_silhouette)
+            quality = assess(prep, full_resolution_state(refined, prep, predictor.setup, predictor.albedo))
             results.rows[i].update(status=quality["status"], reasons=quality["reasons"], quality=quality)
 
 
@@ -251,6 +255,8 @@ def main() -> None:
     parser.add_argument("--real", type=Path, default=REAL_DIR, help="folder of real photos (skipped if absent)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--no-status", action="store_true", help="skip de-rendering (IoU table only)")
+    parser.add_argument("--refine", choices=("none", "shape", "full"), default="full",
+                        help="the refinement the status is judged after (radar derender's --refine)")
     parser.add_argument("--sheet", type=Path, help="also write a PNG of the worst-located variants")
     parser.add_argument("--kinds", default=",".join((*KINDS, "handles")),
                         help="comma-separated variant kinds to locate (default: all)")
@@ -272,7 +278,7 @@ def main() -> None:
     if args.sheet:
         worst_sheet(results, items, args.sheet)
     if not args.no_status:
-        judge_status(results, items)
+        judge_status(results, items, refine=args.refine)
         print(status_table(results))
         print(iou_table(Results([r for r in results.rows if r["kind"] in BROKEN])))
         print(support_table(results))
