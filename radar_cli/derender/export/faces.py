@@ -25,7 +25,7 @@ _LOCK = threading.Lock()
 
 def _detect(image: np.ndarray) -> tuple[list, list]:
     """(rectangles, scores) of the face windows in an H x W x 3 uint8 image scoring at least FLOOR (one call at a
-    time: the detector is built once, 0.3 s, and shared)."""
+    time: the detector is built once, 0.3-0.5 s, and shared)."""
     global _DETECTOR
     with _LOCK:
         if _DETECTOR is None:
