@@ -71,6 +71,12 @@ def split_neighbour(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     return (main_component(out), True) if cut else (mask, False)
 
 
+def _base_start(whole: np.ndarray) -> int | None:
+    """The first of the object's lowest BASE rows (None for an object under two rows tall)."""
+    rows = np.nonzero(whole.any(1))[0]
+    return None if len(rows) < 2 else int(rows.max() + 1 - int(BASE * (rows.max() - rows.min() + 1)))
+
+
 def base_off_axis(whole: np.ndarray, core: np.ndarray) -> float:
     """Share of the located object's lowest BASE rows that lies off its symmetric core: near 0 for a vessel
     (its foot and body are symmetric, handles sit higher), large where a neighbour standing beside or behind
@@ -79,11 +85,11 @@ def base_off_axis(whole: np.ndarray, core: np.ndarray) -> float:
     Args:
         whole: n x n bool located object (core and appendages). core: n x n bool, its symmetric core.
     """
-    rows = np.nonzero(whole.any(1))[0]
-    if len(rows) < 2:
+    start = _base_start(whole)
+    if start is None:
         return 0.0
     low = whole.copy()
-    low[: rows.max() + 1 - int(BASE * (rows.max() - rows.min() + 1))] = False
+    low[:start] = False
     return float((low & ~core).sum() / max(int(low.sum()), 1))
 
 
@@ -99,11 +105,11 @@ def cut_base(whole: np.ndarray, core: np.ndarray) -> tuple[np.ndarray, bool]:
     Returns:
         (object, whether anything was cut off).
     """
-    rows = np.nonzero(whole.any(1))[0]
-    if len(rows) < 2 or base_off_axis(whole, core) <= BASE_MERGED:
+    start = _base_start(whole)
+    if start is None or base_off_axis(whole, core) <= BASE_MERGED:
         return whole, False
     _, labels = cv2.connectedComponents((whole & ~core).astype(np.uint8), connectivity=8)
-    low = np.unique(labels[rows.max() + 1 - int(BASE * (rows.max() - rows.min() + 1)) :])
+    low = np.unique(labels[start:])
     parts = np.isin(labels, low[low > 0])
     cut = whole & ~parts
     if parts.sum() > BASE_CUT_MAX * whole.sum() or sor_score(cut) < sor_score(whole) + BASE_CUT_GAIN:
