@@ -58,6 +58,14 @@ def test_a_face_off_the_object_does_not_count() -> None:
     assert face_score(photo, np.zeros_like(whole)) is None
 
 
+def test_a_thin_object_is_not_blown_up() -> None:
+    """A silhouette one pixel wide is looked at no larger than MAX_SIDE (not 400 x its height)."""
+    photo, _ = _jar(face=False)
+    sliver = np.zeros((N, N), bool)
+    sliver[10:500, 200] = True
+    assert face_score(photo, sliver) == FLOOR
+
+
 @pytest.mark.skipif(not (SHARED / "met_gr_DP107005.jpg").exists(), reason="the shared Met photographs are absent")
 @pytest.mark.parametrize("name, has_face", [("met_gr_DP107005", True), ("met_gr_DP117199", False)])
 def test_a_glass_head_flask_shows_its_face(name: str, has_face: bool) -> None:

@@ -14,6 +14,8 @@ import numpy as np
 DETECT_WIDTH = 400
 """The object's width in pixels when faces are looked for: a face a fifth of the object's width or wider is then at
 least 80 px, the detector's window, so it is found without upsampling."""
+MAX_SIDE = 1600
+"""... but no side of the scaled crop over this (a tall, thin object is not blown up to a giant image)."""
 MARGIN = 0.1
 """Backdrop kept round the object's bounding box, as a share of its width (a face's window needs its edges)."""
 FLOOR = -1.0
@@ -66,7 +68,7 @@ def face_score(photo: np.ndarray, whole: np.ndarray) -> float | None:
     pad = int(MARGIN * width)
     v0, v1 = max(rows[0] - pad, 0), min(rows[-1] + pad + 1, whole.shape[0])
     u0, u1 = max(cols[0] - pad, 0), min(cols[-1] + pad + 1, whole.shape[1])
-    scale = DETECT_WIDTH / width
+    scale = min(DETECT_WIDTH / width, MAX_SIDE / max(u1 - u0, v1 - v0))
     size = (max(round((u1 - u0) * scale), 1), max(round((v1 - v0) * scale), 1))
     interp = cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR
     image = cv2.resize(np.ascontiguousarray(photo[v0:v1, u0:u1]), size, interpolation=interp)
