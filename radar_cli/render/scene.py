@@ -19,10 +19,10 @@ from radar_cli.config import CameraConfig, RenderConfig
 from radar_cli.render.lighting import check_material, compose, decompose, shading_factors, upsample
 from radar_cli.render.material import Material
 from radar_cli.render.raycast import Hits, cast_rays
-from radar_cli.render.texture import render_texture, unwrap
+from radar_cli.render.texture import render_texture, sample_surface, unwrap
 from radar_cli.sor.profile import check_sor
 from radar_cli.sor.solid import Solid
-from radar_cli.sor.surface import FRONT_SPAN, FULL_SPAN, surface_grid
+from radar_cli.sor.surface import FRONT_SPAN, FULL_SPAN, SurfaceGrid, surface_grid
 
 
 @dataclass(frozen=True)
@@ -137,6 +137,7 @@ def divide_shading(
     silhouette: torch.Tensor | None = None,
     max_specular_share: float = MAX_SPECULAR_SHARE,
     span: float = FRONT_SPAN,
+    grid: SurfaceGrid | None = None,
 ) -> torch.Tensor:
     """The albedo as the image's unwrapped frontal texture divided by the shading of a predicted shape, lighting
     and material (Eq. 5 inverted, lighting.decompose): it keeps the image's detail and draws the image back (up to
@@ -154,12 +155,14 @@ def divide_shading(
             blended by the coverage.
         span: half-width in radians of the angles unwrapped (default the frontal third; `albedo`, `shading` and
             render.tex_width cover the same).
+        grid: the solid's surface grid over that span at the texture's size, if the caller has it already.
 
     Returns:
         B x 3 x Ht x Wt linear albedo in [0, 1].
     """
     stacked = image if silhouette is None else torch.cat([image, silhouette], dim=1)  # B x (3 or 4) x S x S
-    unwrapped = unwrap(solid, stacked, (render.tex_height, render.tex_width), camera, span)
+    unwrapped = (unwrap(solid, stacked, (render.tex_height, render.tex_width), camera, span) if grid is None
+                 else sample_surface(stacked, grid, camera))
     divided = decompose(unwrapped[:, :3], shading.diffuse, shading.specular, rho, render.gamma, max_specular_share)
     if silhouette is None:
         return divided

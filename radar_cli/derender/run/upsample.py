@@ -122,12 +122,13 @@ def _divided_albedo(image: torch.Tensor, coverage: torch.Tensor | None, appendag
     material = Material(fallback, dec.env.float(), dec.alpha.float(), dec.rho.float())
     solid = Solid(dec.radius.float(), dec.height.float(), dec.pose.float())
     shading = shade(solid, material, render, setup.camera, span)
-    wide = divide_shading(image, solid, fallback, material.rho, shading, render, setup.camera, coverage, span=span)
+    grid = surface_grid(solid, side, side + 2 * extra, setup.camera, span)
+    wide = divide_shading(image, solid, fallback, material.rho, shading, render, setup.camera, coverage, span=span,
+                          grid=grid)
     if extra == 0:
         return full_from_front(wide)
     sides = full_from_front(wide[..., extra : extra + side])  # the frontal third mirrored round, 1 x 3 x N x 3N
     mirrored = front_third(sides, extra)
-    grid = surface_grid(solid, side, side + 2 * extra, setup.camera, span)
     facing = (grid.normals * grid.view).sum(-1)[:, None]  # 1 x 1 x N x N + 2k
     lo, hi = SEEN_FACING
     trust = ((facing - lo) / (hi - lo)).clamp(0.0, 1.0)
