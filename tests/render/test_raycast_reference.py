@@ -80,3 +80,18 @@ def test_hit_mask_is_the_casts_hard_silhouette(random_sor, size):
     assert torch.equal(mask, cast_rays(solid, size, CameraConfig(), 1.0, soft_outside=False).mask)
     assert torch.equal(mask, cast_rays(solid, size, CameraConfig(), 1.0).mask)
     assert 0 < int(mask.sum()) < mask.numel()
+
+
+def test_the_search_in_chunks_finds_what_it_finds_at_once(random_sor, monkeypatch):
+    """The ray search runs in chunks of rays (small on the CPU, large on a GPU): each ray's result is its own, so a
+    cast in 7 chunks is the same bits as in one."""
+    from radar_cli.render import intersect
+
+    radius, height, pose = random_sor(3, seed=5, dtype=torch.float32)
+    solid = Solid(radius, height, pose)
+    monkeypatch.setattr(intersect, "SEARCH_CHUNK", 1 << 30)
+    whole = cast_rays(solid, 64, CameraConfig(), 1.0)
+    monkeypatch.setattr(intersect, "SEARCH_CHUNK", 64 * 64 * 3 // 7 + 1)
+    chunked = cast_rays(solid, 64, CameraConfig(), 1.0)
+    for name in ("mask", "inner", "sil", "depth", "normal", "uv", "points"):
+        assert torch.equal(getattr(whole, name), getattr(chunked, name)), name
