@@ -3,10 +3,12 @@
 The border band is read along the ring it makes around the photo. An object that runs into the frame crosses
 the band with its outline: a sharp colour step along the ring. Shading of the backdrop (a sweep, a vignette,
 a light pool) changes its colour slowly, however much in all. The ring is cut at the sharp steps into runs;
-with none, or only one, the whole band is backdrop. Otherwise the backdrop is the largest (in pixels) set of
-runs whose median colours agree, grown by the runs that a linear colour gradient through that set explains
-(a sweep), by long runs of a somewhat different colour (a whole side of the frame lit differently), and by the
-runs that continue a backdrop run's colour across a short interruption (a label, a chart, a scale bar).
+with none, or only one, the whole band is backdrop. Otherwise the backdrop is the set of runs, each at least
+half explained by one linear colour gradient across the frame (a flat backdrop or a sweep), that holds the most
+explained pixels; of two neighbouring runs of clearly different colours at most one is in it (the step between
+them is the object's outline). It is grown by long runs of a somewhat different colour (a whole side of the frame
+lit differently) and by the runs that continue a backdrop run's colour across a short interruption (a label, a
+chart, a scale bar).
 
 A flat frame round the picture (a black or white border that squared the photo up) is neither backdrop nor
 object (`frame_padding`).
@@ -27,6 +29,7 @@ RUN_TOLERANCE = 14.0  # ... pieces whose median colours a gradient explains this
 GRADIENT_TRIES = 400  # random triples of pieces a gradient is fitted through
 END_SPAN = 6  # a run's end colour is read over this many pixels along the ring
 BRIDGE = 0.2  # a run continues a chosen one across interruptions of at most this share of the ring
+OUTLINE_STEP = 40.0  # two neighbouring runs this far apart in median colour (levels) are object and backdrop
 LONG_SHARE = 0.5  # a run at least this share as long as the longest backdrop run ...
 LONG_TOLERANCE = 65.0  # ... is backdrop as well if its median colour is this close (levels) to a backdrop run's
 PAD_MAX = 0.02  # a flat frame round the picture is at most this share of its long side deep ...
@@ -152,10 +155,20 @@ def _chunks(runs: list[Run], piece: float) -> tuple[np.ndarray, np.ndarray, list
     return np.array(owner), np.array([len(p) for p in pixels], np.float64), pixels
 
 
-def _gradient_inliers(colours: np.ndarray, centres: np.ndarray, size: np.ndarray) -> np.ndarray:
-    """P bool: the largest (in pixels) set of pieces whose colours one linear colour gradient across the frame
-    explains within RUN_TOLERANCE (a flat backdrop or a sweep), found from GRADIENT_TRIES random triples of
-    pieces and single pieces (flat), then refitted to its inliers."""
+def _backdrop_runs(runs: list[Run], colours: np.ndarray, centres: np.ndarray, size: np.ndarray,
+                   owner: np.ndarray) -> np.ndarray:
+    """R bool: the runs that one linear colour gradient across the frame (a flat backdrop or a sweep) explains,
+    each at least half of its pixels within RUN_TOLERANCE. Of two neighbouring runs of clearly different colours
+    (OUTLINE_STEP: the sharp step between them is an outline crossing the band) at most one is backdrop: the one
+    it explains more of. The gradient is the one whose runs hold the most explained pixels, from GRADIENT_TRIES
+    random triples of pieces and single pieces (flat), then refitted to those pixels. Counting whole runs, not
+    pieces, keeps a steep gradient through a dark rim cut by the top edge and the light floor under the foot from
+    outweighing one long run that changes slowly: the backdrop round three sides.
+
+    Args:
+        colours, centres, size, owner: per piece of the runs (`_chunks`): its median colour (P x 3), its centre
+            in the frame (P x 2, fractions of width and height), its pixels and its run.
+    """
     design = np.column_stack([np.ones(len(colours)), centres])  # P x 3
     rng = np.random.default_rng(0)
     triples = rng.integers(0, len(colours), (GRADIENT_TRIES, 3))
@@ -164,15 +177,36 @@ def _gradient_inliers(colours: np.ndarray, centres: np.ndarray, size: np.ndarray
     flat[:, 0] = colours  # each piece's colour everywhere
     coefs = np.concatenate([coefs, flat])
     inliers = np.linalg.norm(colours[None] - design[None] @ coefs, axis=2) < RUN_TOLERANCE  # T x P
-    best = inliers[int(np.argmax(inliers @ size))]
+    member = np.eye(len(runs))[owner]  # P x R
+    run_size = size @ member  # R
+    stepped = [r for r in range(len(runs))
+               if np.linalg.norm(runs[r].median - runs[(r + 1) % len(runs)].median) >= OUTLINE_STEP]
+
+    def held(inl: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(... x P bool inliers) -> (... x R bool runs held, ... explained pixels in them)."""
+        inside = (inl * size) @ member  # ... x R
+        keep = inside >= 0.5 * run_size
+        for r in stepped:  # neighbours across an outline: the one less explained is let go
+            q = (r + 1) % len(runs)
+            both = keep[..., r] & keep[..., q]
+            first_less = inside[..., r] < inside[..., q]
+            keep[..., r] &= ~(both & first_less)
+            keep[..., q] &= ~(both & ~first_less)
+        return keep, (inside * keep).sum(-1)
+
+    keep, score = held(inliers)
+    best = int(np.argmax(score))
+    runs_kept, best_score, best_inl = keep[best], score[best], inliers[best]
     root = np.sqrt(size)[:, None]
-    for _ in range(2):
-        coef, *_ = np.linalg.lstsq(design[best] * root[best], colours[best] * root[best], rcond=None)
+    for _ in range(2 if runs_kept.any() else 0):
+        use = best_inl & runs_kept[owner]
+        coef, *_ = np.linalg.lstsq(design[use] * root[use], colours[use] * root[use], rcond=None)
         refit = np.linalg.norm(colours - design @ coef, axis=1) < RUN_TOLERANCE
-        if size[refit].sum() < size[best].sum():
+        refit_kept, refit_score = held(refit)
+        if refit_score < best_score:
             break
-        best = refit
-    return best
+        runs_kept, best_score, best_inl = refit_kept, refit_score, refit
+    return runs_kept
 
 
 def backdrop_band(image: np.ndarray) -> np.ndarray:
@@ -190,14 +224,14 @@ def backdrop_band(image: np.ndarray) -> np.ndarray:
     owner, size, pieces = _chunks(runs, sum(r.length for r in runs) / RING_PIECES)
     colours = np.array([np.median(flat[p], axis=0) for p in pieces])  # P x 3
     centres = np.array([[(p % w).mean() / w, (p // w).mean() / h] for p in pieces])  # P x 2
-    agree = _gradient_inliers(colours, centres, size)
-    weight = np.array([len(r.pixels) for r in runs], np.float64)
-    chosen = np.bincount(owner, size * agree, len(runs)) >= 0.5 * weight  # runs mostly of agreeing pieces
+    chosen = _backdrop_runs(runs, colours, centres, size, owner)
     if not chosen.any():
         return band
+    weight = np.array([len(r.pixels) for r in runs], np.float64)
     colours = np.array([r.median for r in runs])  # R x 3
-    long = weight >= LONG_SHARE * weight[chosen].max()  # whole sides of the frame, lit differently
-    near = (np.linalg.norm(colours[:, None] - colours[chosen][None], axis=2) < LONG_TOLERANCE).any(1)
+    long = weight >= LONG_SHARE * weight[chosen].max()  # whole sides of the frame, lit differently, if near
+    # the colour of a long backdrop run (not of a fragment between two steps that the gradient happens to explain)
+    near = (np.linalg.norm(colours[:, None] - colours[chosen & long][None], axis=2) < LONG_TOLERANCE).any(1)
     chosen = _bridged(runs, chosen | (long & near))
     out = np.zeros(h * w, bool)
     for r, keep in zip(runs, chosen):

@@ -1,10 +1,12 @@
 """Which parts of the border show the backdrop: a vignette or sweep however steep is all backdrop, an object
-running into the frame is not, a label standing in the band does not cut the backdrop beyond it off, and a flat
-frame round the picture is found. The pictures are drawn here."""
+running into the frame is not (a dark rim cut by the top edge above a lit floor neither), a label standing in the
+band does not cut the backdrop beyond it off, and a flat frame round the picture is found. The pictures are drawn
+here."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from radar_cli.masks.border import PAD_SMEAR, backdrop_band, border_band, frame_inset, frame_padding
 from radar_cli.masks.neighbours import base_off_axis
@@ -63,6 +65,25 @@ def test_a_label_in_the_band_does_not_cut_off_the_floor_beyond_it() -> None:
     band = border_band(photo.shape[:2])
     assert kept[band & (label | chart)].mean() < 0.05
     assert kept[floor].mean() > 0.95
+
+
+@pytest.mark.parametrize("floor, power", [(0.6, 2.0), (0.75, 1.0), (0.88, 0.5)])
+def test_a_rim_cut_by_the_top_edge_is_not_taken_for_the_backdrop(floor: float, power: float) -> None:
+    """A tight crop: the dark rim runs past the top edge and the handles past both sides, on a sweep whose floor is
+    lit brighter than its wall. A steep gradient from the dark top to the light floor explains the rim and part of
+    the backdrop's run; the wall and floor, one run without a sharp step, are the backdrop, and the rim is not
+    (the wall and the rim are neighbours across an outline, so not both backdrop)."""
+    y = np.mgrid[0:H, 0:W][0] / H
+    grey = 0.48 + 0.14 * np.clip((y - floor) / (1 - floor), 0, 1) ** power
+    image = np.repeat(grey[..., None], 3, axis=2)
+    vessel = ellipse(120, 150, 105, 120)
+    vessel[:60, 20 : W - 20] = True  # the rim cut by the top edge
+    vessel[:45, :30] = vessel[:45, -30:] = True  # the handles cut by the side edges
+    image[vessel] = [0.11, 0.1, 0.09]
+    photo = to_uint8(image)
+    band, kept = border_band(photo.shape[:2]), backdrop_band(photo)
+    assert kept[band & vessel].mean() < 0.05
+    assert kept[band & ~vessel].mean() > 0.97
 
 
 def test_a_flat_frame_round_the_picture_is_found_and_a_plain_backdrop_is_not() -> None:
