@@ -102,6 +102,9 @@ class QualityLimits:
     `above_rim_rise`): review. A volute or a handle's plate seen end-on is thin and low."""
     review_cut_top: bool = True
     """An object the photo's top edge cuts: review (its rim, and whatever stands on it, is not in the photo)."""
+    review_cut_sides: bool = True
+    """An object both side edges of the photo cut: review (its widest rows, and so its radius, are not in the
+    photo: a tight crop of a cylinder is rebuilt narrower than the vessel)."""
 
 
 def psnr(a: np.ndarray, b: np.ndarray) -> float:
@@ -215,6 +218,8 @@ def judge(record: dict, limits: QualityLimits = QualityLimits()) -> tuple[str, l
         review.append(f"cut by {len(record['cut_edges'])} photo edges")
     elif limits.review_cut_top and "top" in record.get("cut_edges", []):
         review.append("the photo's frame cuts off the object's top: its rim, and whatever stands on it, is not seen")
+    elif limits.review_cut_sides and {"left", "right"} <= set(record.get("cut_edges", [])):
+        review.append("the photo's frame cuts off both sides of the object: its full width is not seen")
     review += neighbour_reasons(record, limits)
     if failed:
         return "failed", failed + review
