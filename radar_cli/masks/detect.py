@@ -360,6 +360,16 @@ def _best_reading(small: np.ndarray, readings: list[tuple[np.ndarray, np.ndarray
     return readings[best][0], readings[best][1], cleaned[best]
 
 
+def _unbeatable(small: np.ndarray, raw: np.ndarray, lead: float) -> np.ndarray | None:
+    """The cleaned object of the forgiving reading if no other reading can beat it in `_best_reading`, else None:
+    its largest object covers READING_SHARE of the photo or more (so it counts however large another reading's
+    is) and its support plus its `lead` reaches 1, the most any other reading can score (ties go to it)."""
+    cleaned = _clean(raw)
+    if _largest_area(cleaned) < READING_SHARE * cleaned.size:
+        return None
+    return cleaned if _support(small, cleaned) + lead >= 1.0 else None
+
+
 def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) -> list[Detection]:
     """Find the objects in a studio photograph.
 
@@ -379,9 +389,14 @@ def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) ->
     # backdrop?): the reading whose outline lies more on the photo's edges is kept (one that finds no object
     # of MIN_AREA_FRAC does not count); on a colour photo the forgiving reading stands unless the other one's
     # outline lies clearly more on edges (a dark vessel on a grey backdrop: its body passes for shade)
-    readings = [_cut(small, band, padding, threshold, thorough, shading) for shading in (True, False)]
     lead = 0.0 if is_greyscale(small) else SHADING_LEAD
-    evidence, raw, mask = _best_reading(small, readings, (lead, 0.0))
+    forgiving = _cut(small, band, padding, threshold, thorough, True)
+    settled = _unbeatable(small, forgiving[1], lead)
+    if settled is not None:  # the strict reading could not win: not made (a GrabCut or two saved)
+        evidence, raw, mask = *forgiving, settled
+    else:
+        strict = _cut(small, band, padding, threshold, thorough, False)
+        evidence, raw, mask = _best_reading(small, [forgiving, strict], (lead, 0.0))
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     if n <= 1:
         return []

@@ -185,3 +185,30 @@ def test_cut_edges_are_the_photos_own_edges() -> None:
     assert crops.cut_edges(mask, crops.CropBox(50, 50, 200), (400, 400)) == ()
     full = np.ones((200, 200), bool)
     assert set(crops.cut_edges(full, crops.CropBox(0, 0, 200), (200, 200))) == {"top", "bottom", "left", "right"}
+
+
+@pytest.mark.parametrize("size", [1.0, 0.4])
+def test_the_strict_reading_is_made_only_when_it_could_win(vases, monkeypatch, size):
+    """A large object whose forgiving reading sits on edges all round cannot be beaten by the reading that counts
+    shading: `detect` then reads the photo once, with the same result as reading it twice; a small one is read
+    twice."""
+    from radar_cli.masks import detect as D
+
+    image, alpha, mask = vases
+    photo, _ = composite(image[0], alpha[0], mask[0], "plain", np.random.default_rng(5))
+    if size < 1.0:  # the object a small part of a wider photo
+        h, w = photo.shape[:2]
+        photo = cv2.copyMakeBorder(photo, h, h, w, w, cv2.BORDER_REPLICATE)
+    calls: list[bool] = []
+    cut = D._cut
+
+    def counted(*args):
+        calls.append(args[-1])
+        return cut(*args)
+
+    monkeypatch.setattr(D, "_cut", counted)
+    once = D.detect(photo, thorough=True)
+    monkeypatch.setattr(D, "_unbeatable", lambda *args: None)  # always both readings
+    twice = D.detect(photo, thorough=True)
+    assert calls[: len(calls) - 2] == ([True] if size == 1.0 else [True, False])
+    assert len(once) == len(twice) and all((a.mask == b.mask).all() and a.box == b.box for a, b in zip(once, twice))
