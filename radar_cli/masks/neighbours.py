@@ -5,7 +5,8 @@ Behind it (`cut_behind`, tried first): the vessel in front hides part of the one
 the neighbour widens one side of the object over a span of rows with the vessel's own outline above and below
 (its neck or rim, its foot), and that side is cut back to the mirror of the other. Beside it
 (`split_neighbour`): the columns' extent over the lower part of the object rises a second time beyond the main
-vessel's flank; the object is cut at the valley between the two humps and the main (larger) one is kept.
+vessel's flank; the object is cut at the valley between the two humps and the main (larger) one is kept, if it
+is the more symmetric for it. Every cut must make the vessel left more of a solid of revolution.
 
 Handles and rims reach out above the body, not down to the floor: only the lower rows are read. Where no
 valley parts them (a vessel behind overlapping the main one by much of its width), what lies off the main
@@ -22,7 +23,8 @@ from radar_cli.masks.refine import main_component
 LOWER = 0.55  # the column profile counts object pixels in this lower share of the object's rows
 SECOND_PEAK = 0.3  # a second hump at least this fraction of the main one's height is a neighbour ...
 VALLEY = 0.6  # ... when the profile between them drops below this fraction of the second hump
-MIN_PART = 0.05  # ... and the part beyond the valley holds at least this share of the object
+MIN_PART = 0.05  # ... and the part beyond the valley holds at least this share of the object ...
+SPLIT_GAIN = 0.02  # ... and the vessel kept is more of a solid of revolution by this much (`quality.sor_score`)
 BASE = 0.4  # `base_off_axis` reads this lowest share of the object's rows
 BASE_MERGED = 0.1  # more of those rows than this off the symmetric core: something probably merged at the base
 BASE_CUT_MAX = 0.25  # `cut_base` cuts at most this share of the object ...
@@ -43,7 +45,9 @@ def _valley(profile: np.ndarray, start: int, step: int) -> int | None:
 
 
 def split_neighbour(mask: np.ndarray) -> tuple[np.ndarray, bool]:
-    """The main vessel of a located n x n bool mask with a merged neighbour cut off at the valley between them.
+    """The main vessel of a located n x n bool mask with a merged neighbour cut off at the valley between them,
+    if the vessel kept is the more symmetric for it (a light figure painted on a low-contrast body can carve a
+    valley into the vessel itself; its half alone is far less a solid of revolution than the whole).
 
     Returns:
         (mask, whether a neighbour was cut off).
@@ -68,7 +72,10 @@ def split_neighbour(mask: np.ndarray) -> tuple[np.ndarray, bool]:
         if (mask & beyond).sum() >= MIN_PART * mask.sum():
             out &= ~beyond
             cut = True
-    return (main_component(out), True) if cut else (mask, False)
+    if not cut:
+        return mask, False
+    kept = main_component(out)
+    return (kept, True) if sor_score(kept) >= sor_score(mask) + SPLIT_GAIN else (mask, False)
 
 
 def _base_start(whole: np.ndarray) -> int | None:

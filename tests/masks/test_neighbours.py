@@ -1,6 +1,7 @@
 """A second vessel standing behind the located one (partly hidden by it, standing higher) is cut off; a lone
 vessel, a one-handled jug, a tilted vessel and a neighbour standing level beside it are left to the rest of the
-locator. A card in front of the foot is cut off the located object; a vessel's own handles are not. The photos and
+locator; one standing beside it is split off at the valley, but not the halves of a vessel that its painting
+carved. A card in front of the foot is cut off the located object; a vessel's own handles are not. The photos and
 masks are drawn here."""
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ import numpy as np
 
 from radar_cli.masks import crop as crops
 from radar_cli.masks.locate import locate_object
-from radar_cli.masks.neighbours import cut_base, cut_behind
+from radar_cli.masks.neighbours import cut_base, cut_behind, split_neighbour
 from radar_cli.masks.refine import iou
 
 H, W = 240, 220
@@ -49,6 +50,19 @@ def test_vessels_of_their_own_shape_are_left_whole() -> None:
         assert not cut_behind(tilted)[1], deg
     beside = vessel(85, 20, 200, 110) | vessel(170, 20, 200, 110)  # standing level: no clean foot below it
     assert not cut_behind(beside)[1]
+
+
+def test_a_neighbour_beside_is_split_off_and_a_vessel_carved_by_its_painting_is_not() -> None:
+    """Two vessels standing level side by side are parted at the valley between them; a vessel whose light
+    painted figure was cut out of it from the rim down (a slit that leaves a valley in its lower columns) stays
+    whole: its half alone is far less a solid of revolution."""
+    main, other = vessel(75, 20, 200, 120), vessel(170, 60, 160, 90)
+    kept, split = split_neighbour(main | other)
+    assert split and iou(kept, main) >= 0.9
+    carved = vessel(110, 20, 200, 130)
+    carved[:160, 104:116] = False  # the figure, as light as the backdrop, open to the mouth
+    kept, split = split_neighbour(carved)
+    assert not split and (kept == carved).all()
 
 
 def test_a_vessel_in_front_of_another_is_located_without_it() -> None:
