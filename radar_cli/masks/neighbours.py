@@ -23,12 +23,16 @@ from radar_cli.masks.refine import main_component
 LOWER = 0.55  # the column profile counts object pixels in this lower share of the object's rows
 SECOND_PEAK = 0.3  # a second hump at least this fraction of the main one's height is a neighbour ...
 VALLEY = 0.6  # ... when the profile between them drops below this fraction of the second hump
-MIN_PART = 0.05  # ... and the part beyond the valley holds at least this share of the object ...
-SPLIT_GAIN = 0.02  # ... and the vessel kept is more of a solid of revolution by this much (`quality.sor_score`)
+MIN_PART = 0.05  # ... and the part beyond the valley holds at least this share of the object
+CUT_GAIN = 0.02  # every cut here must raise the solid-of-revolution score (`quality.sor_score`) by this much
 BASE = 0.4  # `base_off_axis` reads this lowest share of the object's rows
 BASE_MERGED = 0.1  # more of those rows than this off the symmetric core: something probably merged at the base
-BASE_CUT_MAX = 0.25  # `cut_base` cuts at most this share of the object ...
-BASE_CUT_GAIN = 0.02  # ... and only where the cut raises the solid-of-revolution score by this much
+BASE_CUT_MAX = 0.25  # `cut_base` cuts at most this share of the object
+
+
+def _rounder(cut: np.ndarray, whole: np.ndarray) -> bool:
+    """Whether cutting `whole` (n x n bool) down to `cut` leaves more of a solid of revolution (CUT_GAIN)."""
+    return sor_score(cut) >= sor_score(whole) + CUT_GAIN
 
 
 def _valley(profile: np.ndarray, start: int, step: int) -> int | None:
@@ -75,7 +79,7 @@ def split_neighbour(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     if not cut:
         return mask, False
     kept = main_component(out)
-    return (kept, True) if sor_score(kept) >= sor_score(mask) + SPLIT_GAIN else (mask, False)
+    return (kept, True) if _rounder(kept, mask) else (mask, False)
 
 
 def _base_start(whole: np.ndarray) -> int | None:
@@ -104,7 +108,7 @@ def cut_base(whole: np.ndarray, core: np.ndarray) -> tuple[np.ndarray, bool]:
     """The located object with what stands in front of or beside its foot cut off: where more of its lowest rows
     than BASE_MERGED lie off its symmetric core (`base_off_axis`), the connected parts off the core that reach
     into those rows (a card or label in front of the foot, a neighbour beside it) are cut, if they are a small
-    part of the object (BASE_CUT_MAX) and the vessel left is more of a solid of revolution (BASE_CUT_GAIN). A
+    part of the object (BASE_CUT_MAX) and the vessel left is more of a solid of revolution (CUT_GAIN). A
     vessel's own foot is symmetric and its handles sit higher.
 
     Args:
@@ -119,7 +123,7 @@ def cut_base(whole: np.ndarray, core: np.ndarray) -> tuple[np.ndarray, bool]:
     low = np.unique(labels[start:])
     parts = np.isin(labels, low[low > 0])
     cut = whole & ~parts
-    if parts.sum() > BASE_CUT_MAX * whole.sum() or sor_score(cut) < sor_score(whole) + BASE_CUT_GAIN:
+    if parts.sum() > BASE_CUT_MAX * whole.sum() or not _rounder(cut, whole):
         return whole, False
     return cut, True
 
@@ -133,7 +137,6 @@ BEHIND_END = 0.015  # ... with at least this share of the rows clean above it an
 BEHIND_CLEAN = (0.3, 0.4)  # ... and at least these shares of the rows above it and below it clean ...
 BEHIND_FILL = 0.75  # ... and fills this share of its rows' span (a handle's loop does not) ...
 BEHIND_MAX = 0.4  # ... but holds at most this share of the object (the vessel in front hides much of it)
-BEHIND_GAIN = 0.02  # the cut must raise the solid-of-revolution score (`quality.sor_score`) by this much
 
 
 def _behind_axis(mid: np.ndarray, side: int, tol: float) -> float:
@@ -186,7 +189,7 @@ def cut_behind(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     the vessel's axis is where those clean rows' midpoints gather (the other rows' lie beyond it on that side);
     the neighbour is the largest part of the object past the mirror of the other side, and it is cut off where
     it spans many rows down into the lower part, is solid and sticks out well, and the vessel left is more of a
-    solid of revolution than before (`BEHIND_GAIN`; a tilted vessel's flank passes the rest).
+    solid of revolution than before (`CUT_GAIN`; a tilted vessel's flank passes the rest).
 
     Returns:
         (mask, whether a neighbour was cut off).
@@ -202,6 +205,6 @@ def cut_behind(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     if not parts:
         return mask, False
     cut = main_component(mask & ~max(parts, key=lambda p: int(p.sum())))
-    if sor_score(cut) < sor_score(mask) + BEHIND_GAIN:  # a tilted vessel's own flank, not a neighbour's
+    if not _rounder(cut, mask):  # a tilted vessel's own flank, not a neighbour's
         return mask, False
     return cut, True
