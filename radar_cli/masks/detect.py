@@ -14,6 +14,7 @@ all of it and decides the object's pixels.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import cv2
@@ -346,28 +347,31 @@ def _support(small: np.ndarray, mask: np.ndarray) -> float:
     return (outline_support(small, mask) or 0.0) if mask.mean() >= MIN_AREA_FRAC else -1.0
 
 
-def _best_reading(small: np.ndarray, readings: list[tuple[np.ndarray, np.ndarray]], lead: tuple[float, ...]
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(evidence, object pixels, cleaned object) of the reading whose outline lies most on the photo's edges
-    (`_support` plus the reading's `lead`); a reading whose largest object is under READING_SHARE of another's
-    found only specks of the object (a low-contrast vessel taken for the backdrop's shading) and does not
-    count."""
-    cleaned = [_clean(raw) for _, raw in readings]
-    largest = [_largest_area(m) for m in cleaned]
-    scores = [_support(small, m) + bonus if area >= READING_SHARE * max(largest) else -1.0
-              for m, area, bonus in zip(cleaned, largest, lead)]
-    best = int(np.argmax(scores))
-    return readings[best][0], readings[best][1], cleaned[best]
-
-
-def _unbeatable(small: np.ndarray, raw: np.ndarray, lead: float) -> np.ndarray | None:
-    """The cleaned object of the forgiving reading if no other reading can beat it in `_best_reading`, else None:
-    its largest object covers READING_SHARE of the photo or more (so it counts however large another reading's
-    is) and its support plus its `lead` reaches 1, the most any other reading can score (ties go to it)."""
+def _scored(small: np.ndarray, raw: np.ndarray) -> tuple[np.ndarray, int, float]:
+    """(cleaned object, its largest component's pixels, its `_support`) of one reading's object pixels."""
     cleaned = _clean(raw)
-    if _largest_area(cleaned) < READING_SHARE * cleaned.size:
-        return None
-    return cleaned if _support(small, cleaned) + lead >= 1.0 else None
+    return cleaned, _largest_area(cleaned), _support(small, cleaned)
+
+
+def _best_reading(small: np.ndarray, read: Callable[[bool], tuple[np.ndarray, np.ndarray]], lead: float
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(evidence, object pixels, cleaned object) of the reading whose outline lies most on the photo's edges:
+    `read(True)` forgives the backdrop's shading and scores its `_support` plus `lead`, `read(False)` does not and
+    scores its `_support`; a reading whose largest object is under READING_SHARE of the other's found only specks
+    of the object (a low-contrast vessel taken for the backdrop's shading) and does not count; a tie goes to the
+    forgiving reading. The second reading is made only if it could win: not where the first one's object covers
+    READING_SHARE of the photo (so it counts however large the other's is) and its score reaches 1, the most the
+    other can score."""
+    forgiving = read(True)
+    cleaned, area, support = _scored(small, forgiving[1])
+    if area >= READING_SHARE * cleaned.size and support + lead >= 1.0:
+        return (*forgiving, cleaned)
+    strict = read(False)
+    strict_cleaned, strict_area, strict_support = _scored(small, strict[1])
+    largest = max(area, strict_area)
+    score = support + lead if area >= READING_SHARE * largest else -1.0
+    strict_score = strict_support if strict_area >= READING_SHARE * largest else -1.0
+    return (*forgiving, cleaned) if score >= strict_score else (*strict, strict_cleaned)
 
 
 def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) -> list[Detection]:
@@ -385,18 +389,14 @@ def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) ->
     small, scale = downscale(image)
     padding = frame_padding(small)  # a flat frame round the picture: it must not join the object to its edges
     band = backdrop_band(small) & ~padding
-    # the photo is read twice, shading forgiven and not (a shadow, or a vessel a little darker than its
-    # backdrop?): the reading whose outline lies more on the photo's edges is kept (one that finds no object
-    # of MIN_AREA_FRAC does not count); on a colour photo the forgiving reading stands unless the other one's
-    # outline lies clearly more on edges (a dark vessel on a grey backdrop: its body passes for shade)
+    # the photo is read with its shading forgiven and, where that reading could lose, not (a shadow, or a vessel
+    # a little darker than its backdrop?): the reading whose outline lies more on the photo's edges is kept (one
+    # that finds no object of MIN_AREA_FRAC does not count); on a colour photo the forgiving reading stands unless
+    # the other one's outline lies clearly more on edges (a dark vessel on a grey backdrop: its body passes for
+    # shade)
     lead = 0.0 if is_greyscale(small) else SHADING_LEAD
-    forgiving = _cut(small, band, padding, threshold, thorough, True)
-    settled = _unbeatable(small, forgiving[1], lead)
-    if settled is not None:  # the strict reading could not win: not made (a GrabCut or two saved)
-        evidence, raw, mask = *forgiving, settled
-    else:
-        strict = _cut(small, band, padding, threshold, thorough, False)
-        evidence, raw, mask = _best_reading(small, [forgiving, strict], (lead, 0.0))
+    evidence, raw, mask = _best_reading(
+        small, lambda shading: _cut(small, band, padding, threshold, thorough, shading), lead)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     if n <= 1:
         return []
