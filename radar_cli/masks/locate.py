@@ -15,7 +15,7 @@ from radar_cli.masks import crop as crops
 from radar_cli.masks.appendages import Core, above_rim, find_axis, symmetric_core, upright_rotation
 from radar_cli.masks.border import frame_inset
 from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fit_backdrop
-from radar_cli.masks.neighbours import base_off_axis, cut_base, cut_behind, split_neighbour
+from radar_cli.masks.neighbours import base_off_axis, cut_at_frame, cut_base, cut_behind, split_neighbour
 from radar_cli.masks.pipeline import (
     Refined,
     Settings,
@@ -237,6 +237,8 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     if not neighbour:
         mask, neighbour = split_neighbour(mask)
     mask, stand = remove_stand(open_gaps(mask, refined.image, refined.outside), refined.image)
+    mask, framed = cut_at_frame(mask, refined.outside)  # after the stand: a plinth cut by the frame is no neighbour
+    neighbour = neighbour or framed
     split: Core = symmetric_core(mask)
     mask, card = cut_base(mask, split.core)
     neighbour = neighbour or card

@@ -6,13 +6,17 @@ the neighbour widens one side of the object over a span of rows with the vessel'
 (its neck or rim, its foot), and that side is cut back to the mirror of the other. Beside it
 (`split_neighbour`): the columns' extent over the lower part of the object rises a second time beyond the main
 vessel's flank; the object is cut at the valley between the two humps and the main (larger) one is kept, if it
-is the more symmetric for it. Every cut must make the vessel left more of a solid of revolution.
+is the more symmetric for it. Cut by the photo's side edge (`cut_at_frame`): a neighbour that reaches the frame
+joins the vessel down to the floor with no valley; the part past the mirror image of the other side that meets
+the frame in a straight line is cut off. Every cut must make the vessel left more of a solid of revolution.
 
 Handles and rims reach out above the body, not down to the floor: only the lower rows are read. Where no
 valley parts them (a vessel behind overlapping the main one by much of its width), what lies off the main
 vessel's symmetric core in the lowest rows (`base_off_axis`) says a neighbour was probably kept with it."""
 
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import cv2
 import numpy as np
@@ -149,26 +153,53 @@ def _behind_axis(mid: np.ndarray, side: int, tol: float) -> float:
     return float(side * candidates[int(np.argmax(counts))])
 
 
-def _behind_part(mask: np.ndarray, rows: np.ndarray, left: np.ndarray, right: np.ndarray, side: int,
-                 tol: float) -> np.ndarray | None:
-    """The n x n bool part of `mask` that a neighbour behind it on `side` adds, or None if none does (see
-    `cut_behind`). left, right: the outermost object column of each of `rows`."""
-    mid, height, width = (left + right) / 2, len(rows), right.max() - left.min() + 1
-    axis = _behind_axis(mid, side, tol)
-    outer, other = (right, left) if side > 0 else (left, right)
-    clip = 2 * axis - other + side * tol  # per row: the mirror of the other side, with the tolerance
+class _Rows(NamedTuple):
+    """The object's rows and, per row, its outermost columns (R = the rows holding object pixels)."""
+
+    rows: np.ndarray  # R
+    left: np.ndarray  # R, float64
+    right: np.ndarray  # R, float64
+    tol: float  # BEHIND_TOLERANCE of the object's width, in pixels (at least 1.5)
+
+
+def _rows(mask: np.ndarray) -> _Rows:
+    rows = np.nonzero(mask.any(1))[0]
+    cols = np.arange(mask.shape[1])
+    left = np.where(mask[rows], cols, mask.shape[1]).min(1).astype(np.float64)
+    right = np.where(mask[rows], cols, -1).max(1).astype(np.float64)
+    return _Rows(rows, left, right, max(1.5, BEHIND_TOLERANCE * (right.max() - left.min() + 1)))
+
+
+def _past_mirror(mask: np.ndarray, r: _Rows, side: int) -> tuple[np.ndarray | None, np.ndarray, np.ndarray]:
+    """The largest n x n bool part of `mask` past the mirror image of the other side (None if none) under the
+    hypothesis that only `side` (+1 right, -1 left) is widened, the R bool rows whose midpoint lies on the axis
+    (clean) and the R mirror columns (with the tolerance)."""
+    mid = (r.left + r.right) / 2
+    axis = _behind_axis(mid, side, r.tol)
+    other = r.left if side > 0 else r.right
+    clip = 2 * axis - other + side * r.tol  # per row: the mirror of the other side, with the tolerance
+    clean = np.abs(mid - axis) <= r.tol
     cols = np.arange(mask.shape[1])
     beyond = np.zeros_like(mask)
-    beyond[rows] = mask[rows] & (side * (cols[None, :] - clip[:, None]) > 0)
-    k = np.ones((2 * int(tol) + 1,) * 2, np.uint8)  # thin parts (a rim's or handle's end) are the vessel's own
+    beyond[r.rows] = mask[r.rows] & (side * (cols[None, :] - clip[:, None]) > 0)
+    k = np.ones((2 * int(r.tol) + 1,) * 2, np.uint8)  # thin parts (a rim's or handle's end) are the vessel's own
     beyond = cv2.morphologyEx(beyond.astype(np.uint8), cv2.MORPH_OPEN, k) > 0
     count, labels, stats, _ = cv2.connectedComponentsWithStats(beyond.astype(np.uint8), connectivity=8)
     if count <= 1:
+        return None, clean, clip
+    return labels == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA])), clean, clip
+
+
+def _behind_part(mask: np.ndarray, r: _Rows, side: int) -> np.ndarray | None:
+    """The n x n bool part of `mask` that a neighbour behind it on `side` adds, or None if none does (see
+    `cut_behind`)."""
+    part, clean, clip = _past_mirror(mask, r, side)
+    if part is None:
         return None
-    part = labels == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
-    held = np.nonzero(part[rows].any(1))[0]
+    height, width = len(r.rows), r.right.max() - r.left.min() + 1
+    outer = r.right if side > 0 else r.left
+    held = np.nonzero(part[r.rows].any(1))[0]
     top, bottom = int(held.min()), int(held.max())
-    clean = np.abs(mid - axis) <= tol
     end = max(3, int(round(BEHIND_END * height)))
     spans = side * (outer[top : bottom + 1] - clip[top : bottom + 1])
     if (bottom - top + 1 < BEHIND_SPAN * height or bottom < BEHIND_LOW * height
@@ -194,17 +225,67 @@ def cut_behind(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     Returns:
         (mask, whether a neighbour was cut off).
     """
-    rows = np.nonzero(mask.any(1))[0]
-    if len(rows) < 20:
+    if mask.any(1).sum() < 20:
         return mask, False
-    cols = np.arange(mask.shape[1])
-    left = np.where(mask[rows], cols, mask.shape[1]).min(1).astype(np.float64)
-    right = np.where(mask[rows], cols, -1).max(1).astype(np.float64)
-    tol = max(1.5, BEHIND_TOLERANCE * (right.max() - left.min() + 1))
-    parts = [p for p in (_behind_part(mask, rows, left, right, side, tol) for side in (1, -1)) if p is not None]
+    r = _rows(mask)
+    parts = [p for p in (_behind_part(mask, r, side) for side in (1, -1)) if p is not None]
     if not parts:
         return mask, False
     cut = main_component(mask & ~max(parts, key=lambda p: int(p.sum())))
     if not _rounder(cut, mask):  # a tilted vessel's own flank, not a neighbour's
         return mask, False
     return cut, True
+
+
+FRAME_SPAN = 0.15  # a neighbour cut by the photo's side edge meets that edge on this share of the object's rows ...
+FRAME_CLEAN = 0.1  # ... and on at least this share of the rows it does not reach the vessel is clean
+
+
+def _meets_frame(part: np.ndarray, outside: np.ndarray, side: int) -> np.ndarray:
+    """n bool: the rows where `part` (n x n bool) reaches the photo's edge on `side` (the window's border or the
+    padding beyond the photo, `outside`)."""
+    edge = np.zeros_like(part)
+    if side > 0:
+        edge[:, -1] = True
+        edge[:, :-1] |= outside[:, 1:]
+    else:
+        edge[:, 0] = True
+        edge[:, 1:] |= outside[:, :-1]
+    return (part & edge).any(1)
+
+
+def cut_at_frame(mask: np.ndarray, outside: np.ndarray | None) -> tuple[np.ndarray, bool]:
+    """The main vessel of a located n x n bool mask with a neighbour that the photo's side edge cuts off removed.
+
+    A vessel beside or behind the main one, cut by the frame, ends at the photo's edge in a straight line and
+    leaves no valley to part them (`split_neighbour`) nor, when it reaches the floor, the vessel's foot clean
+    below it (`cut_behind`). Per side, the largest part of the object past the mirror image of the other side
+    (about the axis the clean rows give) is cut off where it meets the photo's edge on FRAME_SPAN of the
+    object's rows, holds MIN_PART-BEHIND_MAX of it, leaves FRAME_CLEAN of the rows clean, and the vessel left is
+    more of a solid of revolution (`CUT_GAIN`). A vessel that the frame cuts is narrower on that side than its
+    mirror image, not wider.
+
+    Args:
+        mask: n x n bool located object. outside: n x n bool, the window's padding beyond the photo, if any.
+    Returns:
+        (mask, whether a neighbour was cut off).
+    """
+    if mask.any(1).sum() < 20:
+        return mask, False
+    outside = np.zeros_like(mask) if outside is None else outside
+    r = _rows(mask)
+    height, area, best = len(r.rows), int(mask.sum()), None
+    for side in (1, -1):
+        part, clean, _ = _past_mirror(mask, r, side)
+        if part is None:
+            continue
+        held = part[r.rows].any(1)
+        if (_meets_frame(part, outside, side).sum() >= FRAME_SPAN * height
+                and MIN_PART * area <= part.sum() <= BEHIND_MAX * area
+                and clean[~held].sum() >= FRAME_CLEAN * height
+                and (best is None or part.sum() > best.sum())):
+            best = part
+    if best is None:
+        return mask, False
+    cut = main_component(mask & ~best)
+    return (cut, True) if _rounder(cut, mask) else (mask, False)

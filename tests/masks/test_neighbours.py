@@ -1,8 +1,9 @@
 """A second vessel standing behind the located one (partly hidden by it, standing higher) is cut off; a lone
 vessel, a one-handled jug, a tilted vessel and a neighbour standing level beside it are left to the rest of the
 locator; one standing beside it is split off at the valley, but not the halves of a vessel that its painting
-carved. A card in front of the foot is cut off the located object; a vessel's own handles are not. The photos and
-masks are drawn here."""
+carved; one cut by the photo's side edge is cut off where it meets the frame, but not a vessel that the frame
+itself cuts. A card in front of the foot is cut off the located object; a vessel's own handles are not. The
+photos and masks are drawn here."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ import numpy as np
 
 from radar_cli.masks import crop as crops
 from radar_cli.masks.locate import locate_object
-from radar_cli.masks.neighbours import cut_base, cut_behind, split_neighbour
+from radar_cli.masks.neighbours import cut_at_frame, cut_base, cut_behind, split_neighbour
 from radar_cli.masks.refine import iou
 
 H, W = 240, 220
@@ -63,6 +64,28 @@ def test_a_neighbour_beside_is_split_off_and_a_vessel_carved_by_its_painting_is_
     carved[:160, 104:116] = False  # the figure, as light as the backdrop, open to the mouth
     kept, split = split_neighbour(carved)
     assert not split and (kept == carved).all()
+
+
+def test_a_neighbour_cut_by_the_frame_is_cut_off_and_a_vessel_cut_by_it_is_not() -> None:
+    """A vessel standing beside the main one, cut by the photo's right edge, joins it from the shoulder to the
+    floor (no valley, no clean foot below it): it meets the frame in a straight line and is cut off. The main
+    vessel alone, or cut by the frame itself (narrower on that side than its mirror image), is left whole; so is
+    the joined pair where the photo goes on past it (nothing meets the frame)."""
+    main = vessel(95, 20, 200, 120)
+    neighbour = vessel(205, 50, 170, 150)  # overlapping its flank down to the floor, past the right edge
+    joined = main | neighbour
+    assert not split_neighbour(joined)[1] and not cut_behind(joined)[1]
+    outside = np.zeros((H, W), bool)
+    cut, removed = cut_at_frame(joined, outside)
+    assert removed and iou(cut, main) >= 0.95 and not (cut & ~joined).any()
+    for whole in (main, main & (np.arange(W) < 140)[None, :]):  # alone; its right flank cut by the frame
+        kept, removed = cut_at_frame(whole, outside)
+        assert not removed and (kept == whole).all()
+    padded = np.zeros((H, W + 120), bool)  # the same pair with the photo's edge far off: nothing meets it
+    padded[:, :W] = joined
+    padded[:, :W] |= vessel(205, 50, 170, 150)
+    kept, removed = cut_at_frame(padded, np.zeros_like(padded))
+    assert not removed and (kept == padded).all()
 
 
 def test_a_vessel_in_front_of_another_is_located_without_it() -> None:
