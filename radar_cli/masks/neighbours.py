@@ -163,6 +163,7 @@ class _Rows(NamedTuple):
 
 
 def _rows(mask: np.ndarray) -> _Rows:
+    """The rows and outermost columns of an n x n bool mask with object pixels."""
     rows = np.nonzero(mask.any(1))[0]
     cols = np.arange(mask.shape[1])
     left = np.where(mask[rows], cols, mask.shape[1]).min(1).astype(np.float64)
@@ -254,7 +255,7 @@ def _meets_frame(part: np.ndarray, outside: np.ndarray, side: int) -> np.ndarray
     return (part & edge).any(1)
 
 
-def cut_at_frame(mask: np.ndarray, outside: np.ndarray | None) -> tuple[np.ndarray, bool]:
+def cut_at_frame(mask: np.ndarray, outside: np.ndarray) -> tuple[np.ndarray, bool]:
     """The main vessel of a located n x n bool mask with a neighbour that the photo's side edge cuts off removed.
 
     A vessel beside or behind the main one, cut by the frame, ends at the photo's edge in a straight line and
@@ -266,13 +267,12 @@ def cut_at_frame(mask: np.ndarray, outside: np.ndarray | None) -> tuple[np.ndarr
     mirror image, not wider.
 
     Args:
-        mask: n x n bool located object. outside: n x n bool, the window's padding beyond the photo, if any.
+        mask: n x n bool located object. outside: n x n bool, the window's padding beyond the photo.
     Returns:
         (mask, whether a neighbour was cut off).
     """
     if mask.any(1).sum() < 20:
         return mask, False
-    outside = np.zeros_like(mask) if outside is None else outside
     r = _rows(mask)
     height, area, best = len(r.rows), int(mask.sum()), None
     for side in (1, -1):
