@@ -13,9 +13,7 @@ solve for a coarse free map, alternating with the paints, finds where the light 
 its brightest peaks are fitted by Levenberg-Marquardt, again alternating with the paints, once for each of a few
 lobe counts. The photograph pins the light only loosely, and the fits disagree where it does not: the map is
 the mean of their maps. It keeps the starting map's mean, since the albedo's brightness and the light's cannot
-be told apart. A highlight is white light added to the paint: the lobe fits keep it under each usable texel's
-darkest channel (where one paint varies, a figure lighter in its middle, the paints' model cannot draw it, and
-unbounded lobes drew the difference as a highlight the photograph does not have).
+be told apart.
 
 Only the environment map is fitted here; shininess and specular albedo are held at what the caller read
 (derender.refine.driver: f_L's shininess, the specular-albedo reader's specular albedo). With the map unknown, a sharper
@@ -40,9 +38,6 @@ from radar_cli.render.texture import sample_surface
 from radar_cli.sor.solid import Solid
 from radar_cli.sor.surface import surface_grid
 from radar_cli.threads import torch_threads
-
-SATURATED = 0.98
-"""A texel whose darkest display channel reaches this is clipped white: its highlight is not bounded."""
 
 
 @dataclass(frozen=True)
@@ -69,9 +64,6 @@ class LightFitConfig:
             deg at 60).
         start_sharpness: every lobe's starting sharpness.
         min_elevation: lobes stay at or above this elevation (deg): the lights are above the horizon.
-        bound_weight: weight of a highlight's excess over the texel's darkest channel in the lobe fits (a
-            highlight adds white light to the paint, so it cannot be brighter than the photo's darkest channel
-            there; 0 leaves the highlights unbounded).
     """
 
     texels: int = 32
@@ -91,7 +83,6 @@ class LightFitConfig:
     sharpness: tuple[float, float] = (4.0, 60.0)
     start_sharpness: float = 15.0
     min_elevation: float = 0.0
-    bound_weight: float = 50.0
 
 
 @dataclass(frozen=True)
@@ -153,9 +144,7 @@ def paint_labels(albedo: np.ndarray, config: LightFitConfig) -> np.ndarray:
 
 @dataclass(frozen=True)
 class _Texels:
-    """The used texels: Kd, Ks n x (He*We); linear and shown (display) texture 3 x n; paint n indices 0..P-1.
-    And the usable texels that are not clipped white, the paints' outliers too: Ks m x (He*We) and their darkest
-    channel m, linear (a highlight there can add at most that)."""
+    """The used texels: Kd, Ks n x (He*We); linear and shown (display) texture 3 x n; paint n indices 0..P-1."""
 
     kd: torch.Tensor
     ks: torch.Tensor
@@ -164,8 +153,6 @@ class _Texels:
     paint: torch.Tensor
     n_paints: int
     rho: float
-    bound_ks: torch.Tensor
-    bound: torch.Tensor
 
     def paints(self, env: torch.Tensor) -> torch.Tensor:
         """3 x n: each texel's paint albedo under a map (He*We; least squares over the paint's texels), linear."""
@@ -205,11 +192,8 @@ def _texels(crop: np.ndarray, silhouette: np.ndarray, geo: Solid, start: torch.T
     if int(keep.sum()) < 0.05 * g * g:
         return None
     _, paint = torch.unique(labels[keep], return_inverse=True)  # n paint indices 0..P-1
-    darkest = shown.min(0).values
-    bounded = darkest < SATURATED  # a clipped highlight says nothing of how bright it was
     shown = shown[:, keep]
-    return _Texels(kd[keep], ks[keep], shown ** GAMMA, shown, paint, int(paint.max()) + 1, rho, ks[bounded],
-                   darkest[bounded] ** GAMMA)
+    return _Texels(kd[keep], ks[keep], shown ** GAMMA, shown, paint, int(paint.max()) + 1, rho)
 
 
 def _free_map(texels: _Texels, start: torch.Tensor, config: LightFitConfig) -> torch.Tensor:
@@ -261,8 +245,7 @@ def _fit(crop: np.ndarray, silhouette: np.ndarray, radius: torch.Tensor, height:
         return None
     free = _free_map(texels, start, config)
     transport = torch.cat([texels.kd, texels.ks]).T.float().contiguous()  # E x 2n
-    problem = LobeProblem(transport, texels.linear, rho, (start.shape[0], start.shape[1]),
-                          texels.bound_ks.T.float().contiguous(), texels.bound, config.bound_weight)
+    problem = LobeProblem(transport, texels.linear, rho, (start.shape[0], start.shape[1]))
     maps, means = [], []
     for k in config.lobe_counts:
         lobes = fit_lobes(problem, free, k, texels.paints, config.lobe_rounds, config.lobe_steps,

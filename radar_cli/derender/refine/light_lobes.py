@@ -35,21 +35,12 @@ class LobeProblem:
         linear: 3 x n linear texture of the used texels.
         rho: specular albedo, held.
         size: (He, We) of the map.
-        bound_transport: (He*We) x m float32: Ks of the m texels whose highlights are bounded (every usable
-            texel, those left out of the paints included), transposed; None to leave the highlights unbounded.
-        bound: m, each such texel's darkest linear channel: the most a highlight (white light added to the
-            paint) can add there.
-        bound_weight: weight of the squared excess of a texel's highlight over its bound, beside the texture's
-            squared residuals.
     """
 
     transport: torch.Tensor
     linear: torch.Tensor
     rho: float
     size: tuple[int, int]
-    bound_transport: torch.Tensor | None = None
-    bound: torch.Tensor | None = None
-    bound_weight: float = 0.0
 
 
 @functools.lru_cache(maxsize=4)
@@ -128,8 +119,7 @@ def fit_lobes(problem: LobeProblem, start: torch.Tensor, k: int, paints: Callabl
     Starts at the k brightest peaks of `start` with sharpness `start_sharpness` and one shared intensity (least
     squares), then `rounds` times: the paints' albedos from the current map, and Levenberg-Marquardt on the lobes
     (at most `steps` accepted steps, stopping when one lowers the squared residual by less than `tolerance` of
-    it). Elevations stay in [min_elevation, pi/2] and sharpness in `sharpness`. With a bound, the squared
-    residual also holds `bound_weight` x the squared excess of each bounded texel's highlight over its bound.
+    it). Elevations stay in [min_elevation, pi/2] and sharpness in `sharpness`.
 
     Args:
         problem: the texels. start: He x We float64 map the lobes start from.
@@ -140,12 +130,6 @@ def fit_lobes(problem: LobeProblem, start: torch.Tensor, k: int, paints: Callabl
     """
     n = problem.linear.shape[1]
     target = problem.linear.reshape(-1)
-    bound, bound_transport = problem.bound, problem.bound_transport
-    bounded = bound is not None and bound_transport is not None and problem.bound_weight > 0
-    root = math.sqrt(problem.bound_weight)
-    if bounded:
-        assert bound is not None
-        target = torch.cat([target, root * bound])
     lo, hi = math.log(sharpness[0]), math.log(sharpness[1])
     el, az = peak_directions(start, k, min_elevation)
     theta = torch.cat([el, az, torch.full((2 * k,), math.log(start_sharpness), dtype=torch.float64)])
@@ -157,19 +141,12 @@ def fit_lobes(problem: LobeProblem, start: torch.Tensor, k: int, paints: Callabl
         columns = env[None] if jac is None else torch.cat([env[None], jac.T])  # (1 + 4k) x E
         shading = (columns.to(problem.transport.dtype) @ problem.transport).double()  # (1 + 4k) x 2n
         diffuse, specular = shading[:, :n], problem.rho * shading[:, n:]
-        parts = [albedo[c] * diffuse + specular for c in range(3)]
-        if bounded:  # the highlight's excess over the bound, a hinge: max(highlight, bound) against the bound
-            assert bound is not None and bound_transport is not None
-            high = problem.rho * (columns.to(bound_transport.dtype) @ bound_transport).double()  # (1 + 4k) x m
-            over = high[0] > bound
-            parts.append(root * torch.cat([torch.maximum(high[0], bound)[None], high[1:] * over]))
-        rows = torch.cat(parts, 1)  # (1 + 4k) x 3n (+ m)
+        rows = torch.cat([albedo[c] * diffuse + specular for c in range(3)], 1)  # (1 + 4k) x 3n
         return rows[0], (rows[1:].T if jacobian else None)
 
     albedo = paints(start.reshape(-1))
     model, _ = drawn(theta, False, albedo)
-    model, data = model[: 3 * n], target[: 3 * n]
-    theta[3 * k:] = math.log(max(float(model @ data) / max(float(model @ model), 1e-30), 1e-12))
+    theta[3 * k:] = math.log(max(float(model @ target) / max(float(model @ model), 1e-30), 1e-12))
     for _ in range(rounds):
         albedo = paints(bake_lobes(theta, problem.size, False)[0])
         theta = _levenberg_marquardt(functools.partial(drawn, albedo=albedo), target, theta, steps, tolerance,
