@@ -16,6 +16,7 @@ from radar_cli.masks.appendages import Core, above_rim, find_axis, symmetric_cor
 from radar_cli.masks.border import frame_inset
 from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fit_backdrop
 from radar_cli.masks.neighbours import base_off_axis, cut_at_frame, cut_base, cut_behind, split_neighbour
+from radar_cli.masks.on_rim import cut_on_rim
 from radar_cli.masks.pipeline import (
     Refined,
     Settings,
@@ -237,6 +238,7 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     if not neighbour:
         mask, neighbour = split_neighbour(mask)
     mask, stand = remove_stand(open_gaps(mask, refined.image, refined.outside), refined.image)
+    mask, _ = cut_on_rim(mask)  # flowers, stems
     mask, framed = cut_at_frame(mask, refined.outside)  # after the stand: a plinth cut by the frame is no neighbour
     neighbour = neighbour or framed
     split: Core = symmetric_core(mask)

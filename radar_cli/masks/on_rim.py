@@ -1,0 +1,86 @@
+"""Cut off what stands on a located vessel's rim over its mouth: flowers and their stems, a bunch of twigs.
+
+The vessel's central run (the row's object pixels joined to the axis column) widens and narrows smoothly down
+the neck, shoulder and body; at the rim's top it ends. Stems rising from the mouth continue it with a run far
+narrower than the rim (the stems themselves, or the backdrop between them that the cut filled in). From the
+widest central run in the object's upper half, walking up, the first row whose run above is under RIM_STEP of
+its own is the rim's top; the parts above it that come over the middle of the mouth (within half the rim's
+half-width of the axis) are cut off where they are sparse (stems and blossoms, under SPARSE of their bounding
+box: a lid's knob or a head is compact), rise at least MIN_RISE of the object's height, and the vessel left is
+more of a solid of revolution (`neighbours.CUT_GAIN`). Volutes and handles rising above the rim stand at its
+ends, not over the mouth, and stay."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from radar_cli.masks.neighbours import CUT_GAIN
+from radar_cli.masks.quality import sor_score
+from radar_cli.masks.refine import main_component
+
+RIM_STEP = 0.5  # the run above the rim's top row is under this share of the rim's run
+SPARSE = 0.5  # what stands on the rim fills under this share of its bounding box (stems, not a knob)
+MIN_RISE = 0.05  # ... and rises at least this share of the object's height above the rim
+
+
+def central_runs(mask: np.ndarray, axis: int) -> np.ndarray:
+    """n: per row of an n x n bool mask, the length of its run of object pixels through column `axis` (0 where
+    that pixel is backdrop)."""
+    left = np.cumprod(mask[:, axis::-1], axis=1).sum(1)
+    right = np.cumprod(mask[:, axis:], axis=1).sum(1)
+    return np.where(mask[:, axis], left + right - 1, 0)
+
+
+def rim_top(mask: np.ndarray, rows: np.ndarray, runs: np.ndarray) -> int | None:
+    """The row of the rim's top where something continues the central run above it (None if nothing does): from
+    the widest central run in the object's upper half, up to the first row whose run above is under RIM_STEP
+    of its own.
+
+    Args:
+        mask: n x n bool object; rows: its rows (sorted); runs: n central run lengths (`central_runs`).
+    """
+    top, bottom = int(rows[0]), int(rows[-1])
+    upper = rows[rows <= top + 0.5 * (bottom - top)]
+    start = int(upper[np.argmax(runs[upper])])
+    for y in range(start, top, -1):
+        if runs[y] == 0:
+            return None
+        if runs[y - 1] < RIM_STEP * runs[y]:
+            return y
+    return None
+
+
+def cut_on_rim(mask: np.ndarray) -> tuple[np.ndarray, bool]:
+    """The located vessel (n x n bool) without what stands on its rim over the mouth (see the module).
+
+    Returns:
+        (mask, whether anything was cut off).
+    """
+    rows = np.nonzero(mask.any(1))[0]
+    if len(rows) < 20:
+        return mask, False
+    top, bottom = int(rows[0]), int(rows[-1])
+    cols = np.arange(mask.shape[1])
+    lower = rows[rows >= top + 0.5 * (bottom - top)]
+    left = np.where(mask[lower], cols, mask.shape[1]).min(1)
+    right = np.where(mask[lower], cols, -1).max(1)
+    axis = float(np.median((left + right) / 2))  # the body's and foot's midpoints: what stands on top moves none
+    runs = central_runs(mask, int(round(axis)))
+    rim = rim_top(mask, rows, runs)
+    if rim is None or not mask[:rim].any():
+        return mask, False
+    above = mask.copy()
+    above[rim:] = False
+    count, labels = cv2.connectedComponents(above.astype(np.uint8), connectivity=8)
+    middle = np.abs(cols - axis) < 0.25 * runs[rim]  # over the middle of the mouth
+    over = [i for i in range(1, count) if (labels[:, middle] == i).any()]
+    if not over:
+        return mask, False
+    part = np.isin(labels, over)
+    ys, xs = np.nonzero(part)
+    fill = part.sum() / ((ys.max() - ys.min() + 1) * (xs.max() - xs.min() + 1))
+    if fill >= SPARSE or rim - ys.min() < MIN_RISE * (bottom - top + 1):
+        return mask, False
+    cut = main_component(mask & ~part)
+    return (cut, True) if sor_score(cut) >= sor_score(mask) + CUT_GAIN else (mask, False)

@@ -1,0 +1,45 @@
+"""Flowers standing in a vessel's mouth are cut off the located object; a lid's knob, volutes rising at the rim's
+ends and a plain vessel are left whole. The masks are drawn here."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from radar_cli.masks.on_rim import cut_on_rim
+from radar_cli.masks.refine import iou
+
+N = 256
+
+
+def krater(top: int = 90) -> np.ndarray:
+    """N x N bool silhouette of a krater: a wide rim, a neck, a round body, a foot (axis at column 128)."""
+    y, x = np.mgrid[0:N, 0:N].astype(np.float64)
+    t = (y - top) / (N - 20 - top)  # 0 at the rim, 1 under the foot
+    body = 0.5 * np.sqrt(np.clip(1 - ((t - 0.5) / 0.42) ** 2, 0, 1))
+    radius = 150 * np.maximum.reduce([body, np.where(t < 0.06, 0.45, 0.0), np.where((t >= 0.06) & (t < 0.2), 0.36, 0.0),
+                                      np.where((t >= 0.9) & (t <= 1.0), 0.22, 0.0)])
+    return (np.abs(x - 128) <= radius) & (t >= 0) & (t <= 1)
+
+
+def test_flowers_in_the_mouth_are_cut_off() -> None:
+    vessel = krater()
+    flowers = np.zeros((N, N), np.uint8)
+    for x_tip, y_tip in [(70, 20), (110, 10), (150, 15), (190, 25), (128, 35)]:
+        cv2.line(flowers, (128 + (x_tip - 128) // 4, 92), (x_tip, y_tip), 1, 3)
+        cv2.circle(flowers, (x_tip, y_tip), 9, 1, -1)
+    cv2.fillPoly(flowers, [np.array([[112, 92], [144, 92], [128, 60]])], 1)  # the backdrop between the stems, filled
+    cut, removed = cut_on_rim(vessel | (flowers > 0))
+    assert removed and iou(cut, vessel) >= 0.98
+
+
+def test_a_knob_volutes_and_a_plain_vessel_stay() -> None:
+    vessel = krater()
+    knob = vessel.copy()
+    cv2.ellipse(knob.view(np.uint8), (128, 90), (18, 22), 0, 180, 360, 1, -1)  # a lid's knob on the mouth
+    volutes = vessel.copy()
+    for cx in (66, 190):  # curls rising above the rim's ends
+        cv2.circle(volutes.view(np.uint8), (cx, 78), 12, 1, -1)
+    for mask in (vessel, knob, volutes):
+        kept, removed = cut_on_rim(mask)
+        assert not removed and (kept == mask).all()
