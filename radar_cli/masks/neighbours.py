@@ -34,7 +34,7 @@ BASE_MERGED = 0.1  # more of those rows than this off the symmetric core: someth
 BASE_CUT_MAX = 0.25  # `cut_base` cuts at most this share of the object
 
 
-def _rounder(cut: np.ndarray, whole: np.ndarray) -> bool:
+def rounder(cut: np.ndarray, whole: np.ndarray) -> bool:
     """Whether cutting `whole` (n x n bool) down to `cut` leaves more of a solid of revolution (CUT_GAIN)."""
     return sor_score(cut) >= sor_score(whole) + CUT_GAIN
 
@@ -83,7 +83,7 @@ def split_neighbour(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     if not cut:
         return mask, False
     kept = main_component(out)
-    return (kept, True) if _rounder(kept, mask) else (mask, False)
+    return (kept, True) if rounder(kept, mask) else (mask, False)
 
 
 def _base_start(whole: np.ndarray) -> int | None:
@@ -127,7 +127,7 @@ def cut_base(whole: np.ndarray, core: np.ndarray) -> tuple[np.ndarray, bool]:
     low = np.unique(labels[start:])
     parts = np.isin(labels, low[low > 0])
     cut = whole & ~parts
-    if parts.sum() > BASE_CUT_MAX * whole.sum() or not _rounder(cut, whole):
+    if parts.sum() > BASE_CUT_MAX * whole.sum() or not rounder(cut, whole):
         return whole, False
     return cut, True
 
@@ -233,7 +233,7 @@ def cut_behind(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     if not parts:
         return mask, False
     cut = main_component(mask & ~max(parts, key=lambda p: int(p.sum())))
-    if not _rounder(cut, mask):  # a tilted vessel's own flank, not a neighbour's
+    if not rounder(cut, mask):  # a tilted vessel's own flank, not a neighbour's
         return mask, False
     return cut, True
 
@@ -288,4 +288,4 @@ def cut_at_frame(mask: np.ndarray, outside: np.ndarray) -> tuple[np.ndarray, boo
     if best is None:
         return mask, False
     cut = main_component(mask & ~best)
-    return (cut, True) if _rounder(cut, mask) else (mask, False)
+    return (cut, True) if rounder(cut, mask) else (mask, False)

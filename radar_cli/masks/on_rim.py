@@ -15,8 +15,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from radar_cli.masks.neighbours import CUT_GAIN
-from radar_cli.masks.quality import sor_score
+from radar_cli.masks.neighbours import rounder
 from radar_cli.masks.refine import main_component
 
 RIM_STEP = 0.5  # the run above the rim's top row is under this share of the rim's run
@@ -32,13 +31,13 @@ def central_runs(mask: np.ndarray, axis: int) -> np.ndarray:
     return np.where(mask[:, axis], left + right - 1, 0)
 
 
-def rim_top(mask: np.ndarray, rows: np.ndarray, runs: np.ndarray) -> int | None:
+def rim_top(rows: np.ndarray, runs: np.ndarray) -> int | None:
     """The row of the rim's top where something continues the central run above it (None if nothing does): from
     the widest central run in the object's upper half, up to the first row whose run above is under RIM_STEP
     of its own.
 
     Args:
-        mask: n x n bool object; rows: its rows (sorted); runs: n central run lengths (`central_runs`).
+        rows: the object's rows (sorted); runs: n central run lengths (`central_runs`).
     """
     top, bottom = int(rows[0]), int(rows[-1])
     upper = rows[rows <= top + 0.5 * (bottom - top)]
@@ -67,7 +66,7 @@ def cut_on_rim(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     right = np.where(mask[lower], cols, -1).max(1)
     axis = float(np.median((left + right) / 2))  # the body's and foot's midpoints: what stands on top moves none
     runs = central_runs(mask, int(round(axis)))
-    rim = rim_top(mask, rows, runs)
+    rim = rim_top(rows, runs)
     if rim is None or not mask[:rim].any():
         return mask, False
     above = mask.copy()
@@ -83,4 +82,4 @@ def cut_on_rim(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     if fill >= SPARSE or rim - ys.min() < MIN_RISE * (bottom - top + 1):
         return mask, False
     cut = main_component(mask & ~part)
-    return (cut, True) if sor_score(cut) >= sor_score(mask) + CUT_GAIN else (mask, False)
+    return (cut, True) if rounder(cut, mask) else (mask, False)
