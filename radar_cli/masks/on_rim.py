@@ -66,8 +66,8 @@ def cut_on_rim(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     right = np.where(mask[lower], cols, -1).max(1)
     axis = float(np.median((left + right) / 2))  # the body's and foot's midpoints: what stands on top moves none
     runs = central_runs(mask, int(round(axis)))
-    rim = rim_top(rows, runs)
-    if rim is None or not mask[:rim].any():
+    rim = rim_top(rows, runs)  # below the object's top row, so something stands above it
+    if rim is None:
         return mask, False
     above = mask.copy()
     above[rim:] = False
