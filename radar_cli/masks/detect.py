@@ -37,6 +37,8 @@ LIGHT_RANGE = (0.2, 1.6)  # brightness ratios to the backdrop model that shading
 GREY_SPREAD = 4.0  # a photo whose channels differ by less than this (levels) almost everywhere is greyscale
 READING_SHARE = 0.25  # a reading whose largest object is under this share of another reading's does not count
 SHADING_LEAD = 0.05  # on a colour photo the reading that forgives shading wins unless beaten by this much support
+GROWTH = 1.5  # ... or unless the other reading's object is this many times as large ...
+GROWTH_SLACK = 0.02  # ... with its outline on the photo's edges nearly as well (support at most this much lower)
 
 
 @dataclass(frozen=True)
@@ -353,25 +355,33 @@ def _scored(small: np.ndarray, raw: np.ndarray) -> tuple[np.ndarray, int, float]
     return cleaned, _largest_area(cleaned), _support(small, cleaned)
 
 
-def _best_reading(small: np.ndarray, read: Callable[[bool], tuple[np.ndarray, np.ndarray]], lead: float
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _best_reading(small: np.ndarray, read: Callable[[bool], tuple[np.ndarray, np.ndarray]], lead: float,
+                  glance: Callable[[], np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(evidence, object pixels, cleaned object) of the reading whose outline lies most on the photo's edges:
     `read(True)` forgives the backdrop's shading and scores its `_support` plus `lead`, `read(False)` does not and
     scores its `_support`; a reading whose largest object is under READING_SHARE of the other's found only specks
     of the object (a low-contrast vessel taken for the backdrop's shading) and does not count; a tie goes to the
-    forgiving reading. The second reading is made only if it could win: not where the first one's object covers
-    READING_SHARE of the photo (so it counts however large the other's is) and its score reaches 1, the most the
-    other can score."""
+    forgiving reading. The strict reading also wins where its object is GROWTH times as large and its support
+    at most GROWTH_SLACK lower: shade does not add half again to an object and keep its outline on sharp edges;
+    a black body on a dark sweep, or a white one on a pale backdrop, that the forgiving reading took for shade
+    does.
+
+    The second reading is made only if it could win: not where the first one's object covers READING_SHARE of
+    the photo (so it counts however large the other's is), its score reaches 1 (the most the other can score)
+    and `glance()`, the object the strict evidence shows before any cut (H x W bool, a tenth of a reading's
+    cost), is under GROWTH times as large.
+    """
     forgiving = read(True)
     cleaned, area, support = _scored(small, forgiving[1])
-    if area >= READING_SHARE * cleaned.size and support + lead >= 1.0:
+    if area >= READING_SHARE * cleaned.size and support + lead >= 1.0 and _largest_area(glance()) < GROWTH * area:
         return (*forgiving, cleaned)
     strict = read(False)
     strict_cleaned, strict_area, strict_support = _scored(small, strict[1])
     largest = max(area, strict_area)
     score = support + lead if area >= READING_SHARE * largest else -1.0
     strict_score = strict_support if strict_area >= READING_SHARE * largest else -1.0
-    return (*forgiving, cleaned) if score >= strict_score else (*strict, strict_cleaned)
+    grown = strict_area >= GROWTH * area and strict_support >= support - GROWTH_SLACK
+    return (*forgiving, cleaned) if score >= strict_score and not grown else (*strict, strict_cleaned)
 
 
 def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) -> list[Detection]:
@@ -396,7 +406,8 @@ def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) ->
     # shade)
     lead = 0.0 if is_greyscale(small) else SHADING_LEAD
     evidence, raw, mask = _best_reading(
-        small, lambda shading: _cut(small, band, padding, threshold, thorough, shading), lead)
+        small, lambda shading: _cut(small, band, padding, threshold, thorough, shading), lead,
+        lambda: _clean(foreground_evidence(small, band, shading=False) > threshold) & ~padding)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     if n <= 1:
         return []

@@ -215,4 +215,5 @@ def test_the_strict_reading_is_made_only_when_it_could_win(vases, monkeypatch, s
     (forgiving, area, support), (_, strict_area, strict_support) = [D._scored(small, r[1]) for r in readings]
     if size == 1.0:  # the strict reading, made here, would not have won
         assert area >= D.READING_SHARE * max(area, strict_area) and support + lead >= strict_support
+        assert not (strict_area >= D.GROWTH * area and strict_support >= support - D.GROWTH_SLACK)
         assert not (found[0].mask & ~forgiving).any()  # the object found is the forgiving reading's
