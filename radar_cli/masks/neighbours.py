@@ -240,6 +240,7 @@ def cut_behind(mask: np.ndarray) -> tuple[np.ndarray, bool]:
 
 FRAME_SPAN = 0.15  # a neighbour cut by the photo's side edge meets that edge on this share of the object's rows ...
 FRAME_CLEAN = 0.1  # ... and on at least this share of the rows it does not reach the vessel is clean
+FRAME_BOTH = 0.2  # ... unless the other side meets the other edge on more than this share of those rows
 
 
 def _meets_frame(part: np.ndarray, outside: np.ndarray, side: int) -> np.ndarray:
@@ -264,7 +265,9 @@ def cut_at_frame(mask: np.ndarray, outside: np.ndarray) -> tuple[np.ndarray, boo
     (about the axis the clean rows give) is cut off where it meets the photo's edge on FRAME_SPAN of the
     object's rows, holds MIN_PART-BEHIND_MAX of it, leaves FRAME_CLEAN of the rows clean, and the vessel left is
     more of a solid of revolution (`CUT_GAIN`). A vessel that the frame cuts is narrower on that side than its
-    mirror image, not wider.
+    mirror image, not wider; where the object's other side meets the other edge on most of the rows the part
+    meets its edge on (FRAME_BOTH), the frame cuts the vessel itself at both sides (a tight crop of a wide
+    jar): neither side's outline is seen there, so no mirror image tells a neighbour from the vessel's flank.
 
     Args:
         mask: n x n bool located object. outside: n x n bool, the window's padding beyond the photo.
@@ -280,7 +283,9 @@ def cut_at_frame(mask: np.ndarray, outside: np.ndarray) -> tuple[np.ndarray, boo
         if part is None:
             continue
         held = part[r.rows].any(1)
-        if (_meets_frame(part, outside, side).sum() >= FRAME_SPAN * height
+        meets = _meets_frame(part, outside, side)
+        if (meets.sum() >= FRAME_SPAN * height
+                and _meets_frame(mask, outside, -side)[meets].mean() <= FRAME_BOTH
                 and MIN_PART * area <= part.sum() <= BEHIND_MAX * area
                 and clean[~held].sum() >= FRAME_CLEAN * height
                 and (best is None or part.sum() > best.sum())):

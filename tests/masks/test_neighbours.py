@@ -70,7 +70,8 @@ def test_a_neighbour_cut_by_the_frame_is_cut_off_and_a_vessel_cut_by_it_is_not()
     """A vessel standing beside the main one, cut by the photo's right edge, joins it from the shoulder to the
     floor (no valley, no clean foot below it): it meets the frame in a straight line and is cut off. The main
     vessel alone, or cut by the frame itself (narrower on that side than its mirror image), is left whole; so is
-    the joined pair where the photo goes on past it (nothing meets the frame)."""
+    the joined pair where the photo goes on past it (nothing meets the frame), and a wide jar that the frame cuts
+    at both sides (no outline of either flank seen there to mirror)."""
     main = vessel(95, 20, 200, 120)
     neighbour = vessel(205, 50, 170, 150)  # overlapping its flank down to the floor, past the right edge
     joined = main | neighbour
@@ -81,6 +82,9 @@ def test_a_neighbour_cut_by_the_frame_is_cut_off_and_a_vessel_cut_by_it_is_not()
     for whole in (main, main & (np.arange(W) < 140)[None, :]):  # alone; its right flank cut by the frame
         kept, removed = cut_at_frame(whole, outside)
         assert not removed and (kept == whole).all()
+    jar = vessel(90, 20, 200, 320)  # a wide jar off the crop's middle, its body cut by both side edges
+    kept, removed = cut_at_frame(jar, outside)
+    assert not removed and (kept == jar).all()
     padded = np.zeros((H, W + 120), bool)  # the same pair with the photo's edge far off: nothing meets it
     padded[:, :W] = joined
     padded[:, :W] |= vessel(205, 50, 170, 150)
