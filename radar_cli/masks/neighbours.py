@@ -265,9 +265,10 @@ def cut_at_frame(mask: np.ndarray, outside: np.ndarray) -> tuple[np.ndarray, boo
     (about the axis the clean rows give) is cut off where it meets the photo's edge on FRAME_SPAN of the
     object's rows, holds MIN_PART-BEHIND_MAX of it, leaves FRAME_CLEAN of the rows clean, and the vessel left is
     more of a solid of revolution (`CUT_GAIN`). A vessel that the frame cuts is narrower on that side than its
-    mirror image, not wider; where the object's other side meets the other edge on most of the rows the part
-    meets its edge on (FRAME_BOTH), the frame cuts the vessel itself at both sides (a tight crop of a wide
-    jar): neither side's outline is seen there, so no mirror image tells a neighbour from the vessel's flank.
+    mirror image, not wider; where the object's other side meets the other edge on more than FRAME_BOTH of the
+    rows the part meets its edge on, the frame cuts the vessel itself at both sides (a tight crop of a wide jar,
+    its flank ragged where it meets the edge): neither side's outline is seen there, so no mirror image tells a
+    neighbour from the vessel's flank.
 
     Args:
         mask: n x n bool located object. outside: n x n bool, the window's padding beyond the photo.
