@@ -24,7 +24,7 @@ from radar_cli.masks.pipeline import (
     refine_detection,
     refine_window,
 )
-from radar_cli.masks.refine import main_component
+from radar_cli.masks.refine import main_component, row_extents
 
 CUTOUT_MIN_CLEAR = 0.01  # an alpha channel with at least this share of clear pixels is a cut-out's silhouette
 STAND_MIN, STAND_MAX = 0.03, 0.6  # a stand's height as a fraction of the located height
@@ -109,15 +109,6 @@ def alpha_refined(rgb: np.ndarray, opaque: np.ndarray, found: Detection, setting
                    crops.cut(rgb, window, work_side))
 
 
-def _extents(mask: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Leftmost and rightmost object column of each of `rows` (each must hold object pixels)."""
-    cols = np.arange(mask.shape[1])
-    inside = mask[rows]
-    left = np.where(inside, cols, mask.shape[1]).min(1)
-    right = np.where(inside, cols, -1).max(1)
-    return left, right
-
-
 def remove_stand(mask: np.ndarray, image: np.ndarray) -> tuple[np.ndarray, bool]:
     """Cut a stand off the bottom of a located object: the bottom rows with straight sides, a few percent to
     under two thirds of the object's height, clearly wider or narrower than the vessel's foot above them and of
@@ -134,7 +125,7 @@ def remove_stand(mask: np.ndarray, image: np.ndarray) -> tuple[np.ndarray, bool]
     if len(rows) < 10:
         return mask, False
     height = rows.max() - rows.min() + 1
-    left, right = _extents(mask, rows)
+    left, right = row_extents(mask, rows)
     widths = right - left + 1
     while len(rows) > 10 and widths[-1] < 0.5 * np.median(widths[-10:]):  # a ragged sliver under the stand
         rows, left, right, widths = rows[:-1], left[:-1], right[:-1], widths[:-1]

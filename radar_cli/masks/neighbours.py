@@ -22,7 +22,7 @@ import cv2
 import numpy as np
 
 from radar_cli.masks.quality import sor_score
-from radar_cli.masks.refine import main_component
+from radar_cli.masks.refine import main_component, row_extents
 
 LOWER = 0.55  # the column profile counts object pixels in this lower share of the object's rows
 SECOND_PEAK = 0.3  # a second hump at least this fraction of the main one's height is a neighbour ...
@@ -165,9 +165,7 @@ class _Rows(NamedTuple):
 def _rows(mask: np.ndarray) -> _Rows:
     """The rows and outermost columns of an n x n bool mask with object pixels."""
     rows = np.nonzero(mask.any(1))[0]
-    cols = np.arange(mask.shape[1])
-    left = np.where(mask[rows], cols, mask.shape[1]).min(1).astype(np.float64)
-    right = np.where(mask[rows], cols, -1).max(1).astype(np.float64)
+    left, right = (e.astype(np.float64) for e in row_extents(mask, rows))
     return _Rows(rows, left, right, max(1.5, BEHIND_TOLERANCE * (right.max() - left.min() + 1)))
 
 

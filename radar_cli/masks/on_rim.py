@@ -16,7 +16,7 @@ import cv2
 import numpy as np
 
 from radar_cli.masks.neighbours import rounder
-from radar_cli.masks.refine import main_component
+from radar_cli.masks.refine import main_component, row_extents
 
 RIM_STEP = 0.5  # the run above the rim's top row is under this share of the rim's run
 SPARSE = 0.5  # what stands on the rim fills under this share of its bounding box (stems, not a knob)
@@ -61,9 +61,7 @@ def cut_on_rim(mask: np.ndarray) -> tuple[np.ndarray, bool]:
         return mask, False
     top, bottom = int(rows[0]), int(rows[-1])
     cols = np.arange(mask.shape[1])
-    lower = rows[rows >= top + 0.5 * (bottom - top)]
-    left = np.where(mask[lower], cols, mask.shape[1]).min(1)
-    right = np.where(mask[lower], cols, -1).max(1)
+    left, right = row_extents(mask, rows[rows >= top + 0.5 * (bottom - top)])
     axis = float(np.median((left + right) / 2))  # the body's and foot's midpoints: what stands on top moves none
     runs = central_runs(mask, int(round(axis)))
     rim = rim_top(rows, runs)  # below the object's top row, so something stands above it

@@ -53,6 +53,14 @@ def main_component(mask: np.ndarray) -> np.ndarray:
     return labels == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
 
 
+def row_extents(mask: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Leftmost and rightmost object column (R int each) of each of `rows` (R) of a bool mask; each row must hold
+    object pixels."""
+    cols = np.arange(mask.shape[1])
+    inside = mask[rows]
+    return np.where(inside, cols, mask.shape[1]).min(1), np.where(inside, cols, -1).max(1)
+
+
 def smooth_boundary(mask: np.ndarray, sigma: float) -> np.ndarray:
     """Blur the 0/1 mask and cut at 0.5: removes pixel staircases and one-pixel spurs, keeps the shape."""
     if sigma <= 0:
