@@ -14,13 +14,16 @@ from PIL import Image
 
 from radar_cli.cli import cli
 from radar_cli.derender.export.environments import builtin_environments, load_environment, normalise
+from radar_cli.derender.export.maps import chw_image
 from radar_cli.derender.export.object_folder import ExportConfig
-from radar_cli.derender.export.renders import ViewRenderer
+from radar_cli.derender.export.renders import ViewRenderer, sampled_columns
 from radar_cli.derender.present.contact_sheet import contact_sheet
 from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.run.state import read_state
 from radar_cli.errors import InputError
-from radar_cli.render.scene import render_view
+from radar_cli.render.lighting import compose
+from radar_cli.render.scene import render_view, rotate_full_map
+from radar_cli.render.texture import render_texture
 from radar_cli.sor.solid import Solid
 
 from .conftest import SIZE, write_photo
@@ -110,6 +113,21 @@ def test_view_renderer_equals_render_view(obj: Path) -> None:
                          100.0, state.render, state.camera, 1.0)
     ref8 = np.clip(ref[0].permute(1, 2, 0).numpy(), 0, 1) * 255
     assert np.abs(fast - ref8).max() <= 1.0
+
+
+@pytest.mark.parametrize("pitch, yaw", [(2.0, 45.0), (30.0, 100.0), (70.0, 200.0)])
+def test_a_spun_view_composes_only_the_columns_it_shows_and_draws_the_same(obj: Path, pitch: float,
+                                                                           yaw: float) -> None:
+    state = read_state(obj)
+    view = ViewRenderer(state, 40, pitch_deg=pitch)
+    shading = view.shading()
+    whole = compose(rotate_full_map(state.material.albedo, yaw), shading.diffuse, shading.specular,
+                    state.material.rho, state.render.gamma)
+    image, _ = render_texture(view.hits, whole, inside_dim=state.render.inside_dim, background=1.0)
+    np.testing.assert_array_equal(view.draw(shading, yaw), chw_image(image))
+    width = state.material.albedo.shape[-1]
+    if pitch < 10:  # level: the inside is hidden, so about the front half is read
+        assert len(sampled_columns(view.hits, width)) < 0.7 * width
 
 
 def test_environment_files_agree(tmp_path: Path) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +22,7 @@ from radar_cli.fileio import atomic_path, to_uint8
 from radar_cli.render.lighting import compose, tone_map
 from radar_cli.render.material import Material
 from radar_cli.render.raycast import Hits, cast_rays
-from radar_cli.render.scene import Shading, render_front, rotate_full_map, shade
+from radar_cli.render.scene import Shading, render_front, shade
 from radar_cli.render.texture import render_texture
 from radar_cli.results import (
     ALBEDO_RENDERED_FILE,
@@ -70,6 +71,7 @@ class ViewRenderer:
                 hits = cast_rays(self.solid, size, state.camera,
                                  state.render.sil_sigma_px)
         self.hits = hits
+        self._columns: torch.Tensor | None = None  # K: the albedo's columns this view reads
 
     @torch.no_grad()
     def shading(self, env: torch.Tensor | None = None) -> Shading:
@@ -80,13 +82,47 @@ class ViewRenderer:
 
     @torch.no_grad()
     def draw(self, shading: Shading, yaw_deg: float = 0.0, background: float = 1.0) -> np.ndarray:
-        """The shaded object spun by `yaw_deg`: size x size x 3 uint8 over a grey level `background`."""
+        """The shaded object spun by `yaw_deg`: size x size x 3 uint8 over a grey level `background`.
+
+        Unspun, the texture is the one `shading` holds; spun, it is composed only on the columns this view
+        reads (elsewhere 0, which the view never shows)."""
         s = self.state
-        albedo = rotate_full_map(s.material.albedo, yaw_deg)
-        texture = compose(albedo, shading.diffuse, shading.specular, s.material.rho, s.render.gamma)
+        if yaw_deg % 360.0 == 0.0:
+            texture = shading.texture
+        else:
+            if self._columns is None:
+                self._columns = sampled_columns(self.hits, s.material.albedo.shape[-1])
+            cols = self._columns
+            albedo = rotated_columns(s.material.albedo, yaw_deg, cols)
+            texture = torch.zeros_like(s.material.albedo)
+            texture[..., cols] = compose(albedo, shading.diffuse[..., cols], shading.specular[..., cols],
+                                         s.material.rho, s.render.gamma)
         image, _ = render_texture(self.hits, texture, front_only=False, inside_dim=s.render.inside_dim,
                                   background=background)
         return chw_image(image)
+
+
+def sampled_columns(hits: Hits, width: int) -> torch.Tensor:
+    """The columns of a 360 deg map `width` columns wide that render_texture reads where the view is covered
+    (hits.sil > 0), a column to spare either side of each bilinear pair: sorted, K (int64)."""
+    u = hits.uv[..., 0][hits.sil > 0].double()
+    # render_texture pads one column each side and samples at grid_sample's pixel x of u_pad
+    x = ((u * (width / (width + 2)) + 1) * (width + 2) - 1) / 2
+    base = torch.floor(x).long()
+    taps = torch.cat([base + k for k in (-1, 0, 1, 2)])
+    return torch.unique((taps - 1) % width)  # padded column p is the map's column p - 1, round the seam
+
+
+def rotated_columns(texture: torch.Tensor, yaw_deg: float, cols: torch.Tensor) -> torch.Tensor:
+    """rotate_full_map(texture, yaw_deg)[..., cols] without spinning the whole map (B x C x Ht x K)."""
+    width = texture.shape[-1]
+    shift = yaw_deg / 360.0 * width
+    whole = math.floor(shift)
+    frac = shift - whole
+    rolled = texture[..., (cols - whole) % width]
+    if frac == 0:
+        return rolled
+    return (1 - frac) * rolled + frac * texture[..., (cols - whole - 1) % width]
 
 
 def render_object(state: ObjectState, size: int, yaw_deg: float = 0.0, pitch_deg: float | None = None,
@@ -101,13 +137,13 @@ def render_object(state: ObjectState, size: int, yaw_deg: float = 0.0, pitch_deg
 
 
 @torch.no_grad()
-def write_input_view(folder: Path, state: ObjectState, size: int) -> tuple[ViewRenderer, np.ndarray]:
+def write_input_view(folder: Path, state: ObjectState, size: int) -> tuple[ViewRenderer, Shading, np.ndarray]:
     """mask.png, mask_front.png, albedo_rendered.png, normal_rendered.png, recon.png, diffuse_rendered.png and
     specular_rendered.png at the input's size.
 
     Returns:
-        (the input view's renderer: its rays serve other views of the same size and pose; the reconstruction,
-        S x S x 3 uint8)."""
+        (the input view's renderer: its rays serve other views of the same size and pose; its shading under the
+        object's own lighting; the reconstruction, S x S x 3 uint8)."""
     view = ViewRenderer(state, size)
     hits = view.hits
     coverage = torch.where(hits.mask, torch.ones_like(hits.sil), hits.sil)  # 1 x S x S
@@ -126,7 +162,7 @@ def write_input_view(folder: Path, state: ObjectState, size: int) -> tuple[ViewR
     gamma, rho = state.render.gamma, state.material.rho[:, None, None, None]
     write_picture(folder / DIFFUSE_RENDERED_FILE, _on_object(hits, tone_map(shading.diffuse, gamma)))
     write_picture(folder / SPECULAR_RENDERED_FILE, _on_object(hits, tone_map(rho * shading.specular, gamma)))
-    return view, recon
+    return view, shading, recon
 
 
 def _on_object(hits: Hits, texture: torch.Tensor) -> np.ndarray:
@@ -177,10 +213,16 @@ def gif_frames(views: list[np.ndarray]) -> list[Image.Image]:
     return frames
 
 
-def write_turntable(folder: Path, view: ViewRenderer, frames: int) -> None:
-    """turntable.gif (looping) and turntable.png (the frames side by side): `frames` equal yaw steps."""
-    shading = view.shading()
-    views = [view.draw(shading, yaw_deg=360.0 * k / frames) for k in range(frames)]
+def write_turntable(folder: Path, view: ViewRenderer, frames: int, shading: Shading | None = None,
+                    first: np.ndarray | None = None) -> None:
+    """turntable.gif (looping) and turntable.png (the frames side by side): `frames` equal yaw steps.
+
+    Args:
+        shading: the view's shading under the object's own lighting, if already known.
+        first: the unspun frame, if already drawn."""
+    shading = view.shading() if shading is None else shading
+    views = [first if k == 0 and first is not None else view.draw(shading, yaw_deg=360.0 * k / frames)
+             for k in range(frames)]
     write_picture(folder / TURNTABLE_STRIP_FILE, np.concatenate(views, axis=1))
     images = gif_frames(views)
     with atomic_path(folder / TURNTABLE_GIF_FILE) as tmp:
@@ -219,11 +261,16 @@ def write_renders(folder: Path, state: ObjectState, input_size: int, view_size: 
     Returns:
         The input view's hard silhouette (S x S bool), where it shows the inside through the mouth (S x S bool)
         and its reconstruction (S x S x 3 uint8), for the quality checks."""
-    input_view, recon = write_input_view(folder, state, input_size)
+    input_view, shading, recon = write_input_view(folder, state, input_size)
     write_picture(folder / MATERIAL_SPHERE_FILE, material_sphere(state, view_size))
-    hits = input_view.hits if view_size == input_size else None
-    view = ViewRenderer(texture_for_size(state, view_size), view_size, hits=hits)
-    if frames > 0:
-        write_turntable(folder, view, frames)
+    view_state = texture_for_size(state, view_size)
+    if view_size == input_size and view_state is state:  # the input view itself: its shading and recon serve
+        view = input_view
+        if frames > 0:
+            write_turntable(folder, view, frames, shading, recon)
+    else:
+        view = ViewRenderer(view_state, view_size, hits=input_view.hits if view_size == input_size else None)
+        if frames > 0:
+            write_turntable(folder, view, frames)
     write_relit(folder, view, envs)
     return input_view.hits.mask[0].numpy(), input_view.hits.inner[0].numpy(), recon
