@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import math
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +21,7 @@ from radar_cli.fileio import atomic_path, to_uint8
 from radar_cli.render.lighting import compose, tone_map
 from radar_cli.render.material import Material
 from radar_cli.render.raycast import Hits, cast_rays
-from radar_cli.render.scene import Shading, render_front, shade
+from radar_cli.render.scene import Shading, render_front, rotate_full_map, shade
 from radar_cli.render.texture import render_texture
 from radar_cli.results import (
     ALBEDO_RENDERED_FILE,
@@ -71,7 +70,6 @@ class ViewRenderer:
                 hits = cast_rays(self.solid, size, state.camera,
                                  state.render.sil_sigma_px)
         self.hits = hits
-        self._columns: torch.Tensor | None = None  # K: the albedo's columns this view reads
 
     @torch.no_grad()
     def shading(self, env: torch.Tensor | None = None) -> Shading:
@@ -82,47 +80,17 @@ class ViewRenderer:
 
     @torch.no_grad()
     def draw(self, shading: Shading, yaw_deg: float = 0.0, background: float = 1.0) -> np.ndarray:
-        """The shaded object spun by `yaw_deg`: size x size x 3 uint8 over a grey level `background`.
-
-        Unspun, the texture is the one `shading` holds; spun, it is composed only on the columns this view
-        reads (elsewhere 0, which the view never shows)."""
+        """The shaded object spun by `yaw_deg`: size x size x 3 uint8 over a grey level `background` (unspun, the
+        texture is the one `shading` holds)."""
         s = self.state
         if yaw_deg % 360.0 == 0.0:
             texture = shading.texture
         else:
-            if self._columns is None:
-                self._columns = sampled_columns(self.hits, s.material.albedo.shape[-1])
-            cols = self._columns
-            albedo = rotated_columns(s.material.albedo, yaw_deg, cols)
-            texture = torch.zeros_like(s.material.albedo)
-            texture[..., cols] = compose(albedo, shading.diffuse[..., cols], shading.specular[..., cols],
-                                         s.material.rho, s.render.gamma)
+            texture = compose(rotate_full_map(s.material.albedo, yaw_deg), shading.diffuse, shading.specular,
+                              s.material.rho, s.render.gamma)
         image, _ = render_texture(self.hits, texture, front_only=False, inside_dim=s.render.inside_dim,
                                   background=background)
         return chw_image(image)
-
-
-def sampled_columns(hits: Hits, width: int) -> torch.Tensor:
-    """The columns of a 360 deg map `width` columns wide that render_texture reads where the view is covered
-    (hits.sil > 0), a column to spare either side of each bilinear pair: sorted, K (int64)."""
-    u = hits.uv[..., 0][hits.sil > 0].double()
-    # render_texture pads one column each side and samples at grid_sample's pixel x of u_pad
-    x = ((u * (width / (width + 2)) + 1) * (width + 2) - 1) / 2
-    base = torch.floor(x).long()
-    taps = torch.cat([base + k for k in (-1, 0, 1, 2)])
-    return torch.unique((taps - 1) % width)  # padded column p is the map's column p - 1, round the seam
-
-
-def rotated_columns(texture: torch.Tensor, yaw_deg: float, cols: torch.Tensor) -> torch.Tensor:
-    """rotate_full_map(texture, yaw_deg)[..., cols] without spinning the whole map (B x C x Ht x K)."""
-    width = texture.shape[-1]
-    shift = yaw_deg / 360.0 * width
-    whole = math.floor(shift)
-    frac = shift - whole
-    rolled = texture[..., (cols - whole) % width]
-    if frac == 0:
-        return rolled
-    return (1 - frac) * rolled + frac * texture[..., (cols - whole - 1) % width]
 
 
 def render_object(state: ObjectState, size: int, yaw_deg: float = 0.0, pitch_deg: float | None = None,
