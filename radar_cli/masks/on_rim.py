@@ -4,11 +4,11 @@ The vessel's central run (the row's object pixels joined to the axis column) wid
 the neck, shoulder and body; at the rim's top it ends. Stems rising from the mouth continue it with a run far
 narrower than the rim (the stems themselves, or the backdrop between them that the cut filled in). From the
 widest central run in the object's upper half, walking up, the first row whose run above is under RIM_STEP of
-its own is the rim's top; the parts above it that come over the middle of the mouth (within half the rim's
-half-width of the axis) are cut off where they are sparse (stems and blossoms, under SPARSE of their bounding
-box: a lid's knob or a head is compact), rise at least MIN_RISE of the object's height, and the vessel left is
-more of a solid of revolution (`neighbours.CUT_GAIN`). Volutes and handles rising above the rim stand at its
-ends, not over the mouth, and stay."""
+the widest of the few rows up to it is the rim's top; the parts above it that come over the middle of the mouth
+(within half the rim's half-width of the axis) are cut off where they are sparse (stems and blossoms, under
+SPARSE of their bounding box: a lid's knob or a head is compact), rise at least MIN_RISE of the object's height,
+and the vessel left is more of a solid of revolution (`neighbours.CUT_GAIN`). Volutes and handles rising above
+the rim stand at its ends, not over the mouth, and stay."""
 
 from __future__ import annotations
 
@@ -18,7 +18,8 @@ import numpy as np
 from radar_cli.masks.neighbours import rounder
 from radar_cli.masks.refine import main_component, row_extents
 
-RIM_STEP = 0.5  # the run above the rim's top row is under this share of the rim's run
+RIM_STEP = 0.5  # the run above the rim's top row is under this share of the rim's run ...
+RIM_WINDOW = 0.01  # ... the widest run of this share of the object's height of rows up to it (at least one row)
 SPARSE = 0.5  # what stands on the rim fills under this share of its bounding box (stems, not a knob)
 MIN_RISE = 0.05  # ... and rises at least this share of the object's height above the rim
 
@@ -34,7 +35,8 @@ def central_runs(mask: np.ndarray, axis: int) -> np.ndarray:
 def rim_top(rows: np.ndarray, runs: np.ndarray) -> int | None:
     """The row of the rim's top where something continues the central run above it (None if nothing does): from
     the widest central run in the object's upper half, up to the first row whose run above is under RIM_STEP
-    of its own.
+    of the widest of the RIM_WINDOW of rows up to it (a rim's top edge may slope over a few rows into a bunch of
+    stems as wide as half the mouth: compared with the row below alone, no step halves).
 
     Args:
         rows: the object's rows (sorted); runs: n central run lengths (`central_runs`).
@@ -42,10 +44,11 @@ def rim_top(rows: np.ndarray, runs: np.ndarray) -> int | None:
     top, bottom = int(rows[0]), int(rows[-1])
     upper = rows[rows <= top + 0.5 * (bottom - top)]
     start = int(upper[np.argmax(runs[upper])])
+    window = max(1, round(RIM_WINDOW * (bottom - top)))
     for y in range(start, top, -1):
         if runs[y] == 0:
             return None
-        if runs[y - 1] < RIM_STEP * runs[y]:
+        if runs[y - 1] < RIM_STEP * runs[y : y + window].max():
             return y
     return None
 

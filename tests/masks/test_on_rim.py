@@ -33,6 +33,22 @@ def test_flowers_in_the_mouth_are_cut_off() -> None:
     assert removed and iou(cut, vessel) >= 0.98
 
 
+def test_a_bunch_as_wide_as_half_the_mouth_is_cut_at_the_rims_sloping_top() -> None:
+    """The rim's top edge slopes over two rows into a filled bunch of stems 0.45 as wide as the rim, which then
+    narrows slowly: no row's run is under half the one below it, but it is under half the rim's."""
+    vessel = krater()
+    rim = vessel.copy()
+    rim[89, 128 - 50 : 128 + 51] = True  # the rim's back arc
+    flowers = np.zeros((N, N), np.uint8)
+    wedge = [[128 - 30, 88], [128 + 30, 88], [128 + 8, 60], [128 - 8, 60]]
+    cv2.fillPoly(flowers, [np.array(wedge)], 1)  # the backdrop between the stems, filled
+    for x_tip, y_tip in [(70, 12), (105, 8), (150, 10), (186, 14)]:
+        cv2.line(flowers, (128 + (x_tip - 128) // 8, 62), (x_tip, y_tip), 1, 3)
+        cv2.circle(flowers, (x_tip, y_tip), 9, 1, -1)
+    cut, removed = cut_on_rim(rim | (flowers > 0))
+    assert removed and iou(cut, rim) >= 0.98
+
+
 def test_a_knob_volutes_and_a_plain_vessel_stay() -> None:
     vessel = krater()
     knob = vessel.copy()
