@@ -1,4 +1,4 @@
-"""CPU seconds of three parts of a `radar derender` object, each against the way it was done before, over the
+"""CPU seconds of four parts of a `radar derender` object, each against the way it was done before, over the
 objects of a results folder (docs/performance.md):
 
     python -m experiments.export_parts RESULTS [--repeats 3]
@@ -7,7 +7,11 @@ objects of a results folder (docs/performance.md):
   against export.palette.quantize; each one's mean error against the frames (levels);
 - mesh.obj: trimesh's OBJ exporter against export.mesh.obj_text (the bytes compared);
 - the refinement's hard silhouette at the output side: a full ray cast against render.raycast.hit_mask, for the
-  profile, height and pose of material.json (the masks compared).
+  profile, height and pose of material.json (the masks compared);
+- the input view, its turntable (8 frames) and its 4 relit views: each view's texture composed anew (and the
+  input view's shading made twice, for it and for the turntable) against ViewRenderer.draw, whose unspun views
+  draw the texture their shading holds, with the turntable started from the input view's shading and
+  reconstruction (the images compared).
 
 Each figure is the best of `repeats` (one torch thread; run with OMP_NUM_THREADS=1)."""
 
@@ -25,9 +29,16 @@ import trimesh
 from PIL import Image
 
 from radar_cli.config import CameraConfig
+from radar_cli.derender.export.environments import builtin_environments, match_exposure
+from radar_cli.derender.export.maps import chw_image
 from radar_cli.derender.export.mesh import OBJ_MTL, obj_text
 from radar_cli.derender.export.palette import quantize
+from radar_cli.derender.export.renders import ViewRenderer
+from radar_cli.derender.run.state import read_state
+from radar_cli.render.lighting import compose
 from radar_cli.render.raycast import cast_rays, hit_mask
+from radar_cli.render.scene import rotate_full_map
+from radar_cli.render.texture import render_texture
 from radar_cli.sor.solid import Solid
 
 
@@ -80,6 +91,39 @@ def iou_cast(folder: Path, repeats: int) -> list[float]:
     return [old_s, new_s, float(torch.equal(old, new))]
 
 
+def views(folder: Path, repeats: int) -> list[float]:
+    """[composing anew s, ViewRenderer.draw s, 1 if the images agree] for the input view, 8 turntable frames and
+    the 4 built-in relit views of the object (its rays cast once, outside the timing)."""
+    state = read_state(folder)
+    view = ViewRenderer(state, int(json.loads((folder / "material.json").read_text())["resolution"]))
+    own = state.material.env[0].numpy()
+    envs = [torch.from_numpy(match_exposure(env, own))[None]
+            for env in builtin_environments(own.shape[0], own.shape[1]).values()]
+
+    def anew(shading, yaw: float) -> np.ndarray:
+        texture = compose(rotate_full_map(state.material.albedo, yaw), shading.diffuse, shading.specular,
+                          state.material.rho, state.render.gamma)
+        image, _ = render_texture(view.hits, texture, inside_dim=state.render.inside_dim, background=1.0)
+        return chw_image(image)
+
+    def before() -> list[np.ndarray]:
+        recon = anew(view.shading(), 0.0)
+        shading = view.shading()
+        return ([recon] + [anew(shading, 45.0 * k) for k in range(8)]
+                + [anew(view.shading(env), 0.0) for env in envs])
+
+    def after() -> list[np.ndarray]:
+        shading = view.shading()
+        recon = view.draw(shading)
+        return ([recon, recon] + [view.draw(shading, 45.0 * k) for k in range(1, 8)]
+                + [view.draw(view.shading(env)) for env in envs])
+
+    with torch.no_grad():
+        old_s, old = best_cpu(before, repeats)
+        new_s, new = best_cpu(after, repeats)
+    return [old_s, new_s, float(all(np.array_equal(a, b) for a, b in zip(old, new)))]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("results", type=Path)
@@ -87,7 +131,7 @@ def main() -> None:
     args = parser.parse_args()
     torch.set_num_threads(1)
     folders = sorted(p.parent for p in args.results.glob("*/material.json"))
-    parts = {"gif": gif_palette, "obj": obj_file, "iou_cast": iou_cast}
+    parts = {"gif": gif_palette, "obj": obj_file, "iou_cast": iou_cast, "views": views}
     rows = {name: np.array([fn(f, args.repeats) for f in folders]) for name, fn in parts.items()}
     print(f"{len(folders)} objects")
     for name, table in rows.items():
