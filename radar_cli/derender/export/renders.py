@@ -232,13 +232,13 @@ def write_renders(folder: Path, state: ObjectState, input_size: int, view_size: 
     input_view, shading, recon = write_input_view(folder, state, input_size)
     write_picture(folder / MATERIAL_SPHERE_FILE, material_sphere(state, view_size))
     view_state = texture_for_size(state, view_size)
+    known: tuple[Shading | None, np.ndarray | None]
     if view_size == input_size and view_state is state:  # the input view itself: its shading and recon serve
-        view = input_view
-        if frames > 0:
-            write_turntable(folder, view, frames, shading, recon)
+        view, known = input_view, (shading, recon)
     else:
         view = ViewRenderer(view_state, view_size, hits=input_view.hits if view_size == input_size else None)
-        if frames > 0:
-            write_turntable(folder, view, frames)
+        known = (None, None)
+    if frames > 0:
+        write_turntable(folder, view, frames, *known)
     write_relit(folder, view, envs)
     return input_view.hits.mask[0].numpy(), input_view.hits.inner[0].numpy(), recon
