@@ -14,6 +14,7 @@ all of it and decides the object's pixels.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -331,9 +332,10 @@ def _groups(boxes: list[tuple[int, int, int, int]], gap: float) -> list[list[int
 
 
 def _cut(small: np.ndarray, band: np.ndarray, padding: np.ndarray, threshold: float, thorough: bool,
-         shading: bool) -> tuple[np.ndarray, np.ndarray]:
-    """(evidence, object pixels) of a detection-scale photo (see `detect`)."""
-    evidence = foreground_evidence(small, band, shading)
+         shading: bool, first: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(evidence, object pixels) of a detection-scale photo (see `detect`); `first`: its first evidence, from the
+    border band, if already known."""
+    evidence = foreground_evidence(small, band, shading) if first is None else first
     raw = coarse_grabcut(small, evidence, threshold, band) & ~padding
     if thorough and raw.any():  # model the backdrop again from all round the object, not only the border
         # (vignettes, light pools, a stand's surroundings), and cut again
@@ -405,9 +407,11 @@ def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) ->
     # the other one's outline lies clearly more on edges (a dark vessel on a grey backdrop: its body passes for
     # shade)
     lead = 0.0 if is_greyscale(small) else SHADING_LEAD
+    strict = functools.cache(lambda: foreground_evidence(small, band, shading=False))  # glanced at, then read
     evidence, raw, mask = _best_reading(
-        small, lambda shading: _cut(small, band, padding, threshold, thorough, shading), lead,
-        lambda: _clean(foreground_evidence(small, band, shading=False) > threshold) & ~padding)
+        small, lambda shading: _cut(small, band, padding, threshold, thorough, shading,
+                                    None if shading else strict()), lead,
+        lambda: _clean(strict() > threshold) & ~padding)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     if n <= 1:
         return []
