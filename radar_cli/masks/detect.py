@@ -332,7 +332,7 @@ def _groups(boxes: list[tuple[int, int, int, int]], gap: float) -> list[list[int
 
 
 def _cut(small: np.ndarray, band: np.ndarray, padding: np.ndarray, threshold: float, thorough: bool,
-         shading: bool, first: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+         shading: bool, *, first: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(evidence, object pixels) of a detection-scale photo (see `detect`); `first`: its first evidence, from the
     border band, if already known."""
     evidence = foreground_evidence(small, band, shading) if first is None else first
@@ -410,7 +410,7 @@ def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) ->
     strict = functools.cache(lambda: foreground_evidence(small, band, shading=False))  # glanced at, then read
     evidence, raw, mask = _best_reading(
         small, lambda shading: _cut(small, band, padding, threshold, thorough, shading,
-                                    None if shading else strict()), lead,
+                                    first=None if shading else strict()), lead,
         lambda: _clean(strict() > threshold) & ~padding)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     if n <= 1:

@@ -202,9 +202,9 @@ def test_the_strict_reading_is_made_only_when_it_could_win(vases, monkeypatch, s
     calls: list[tuple] = []
     cut = D._cut
 
-    def counted(*args):
+    def counted(*args, **kwargs):
         calls.append(args)
-        return cut(*args)
+        return cut(*args, **kwargs)
 
     monkeypatch.setattr(D, "_cut", counted)
     found = D.detect(photo, thorough=True)
