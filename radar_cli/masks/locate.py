@@ -5,7 +5,7 @@ chart, or show the vessel on a stand. The silhouette is split into its symmetric
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
@@ -25,6 +25,7 @@ from radar_cli.masks.pipeline import (
     refine_window,
 )
 from radar_cli.masks.refine import main_component, row_extents
+from radar_cli.masks.sheen import grow_sheen
 
 CUTOUT_MIN_CLEAR = 0.01  # an alpha channel with at least this share of clear pixels is a cut-out's silhouette
 STAND_MIN, STAND_MAX = 0.03, 0.6  # a stand's height as a fraction of the located height
@@ -225,6 +226,7 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
             raise InputError(f"{name}: no object stands out from the backdrop; crop it square or use --crop none")
         found = detections[0]
         refined = refine_detection(rgb, found, settings)
+        refined = replace(refined, mask=grow_sheen(refined.mask, refined.image, refined.outside))  # glaze's band
     mask, neighbour = cut_behind(refined.mask)
     if not neighbour:
         mask, neighbour = split_neighbour(mask)
