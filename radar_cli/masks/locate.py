@@ -14,7 +14,7 @@ from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
 from radar_cli.masks.appendages import Core, above_rim, find_axis, symmetric_core, upright_rotation
 from radar_cli.masks.border import frame_inset
-from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fit_backdrop
+from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fill_holes, fit_backdrop
 from radar_cli.masks.neighbours import base_off_axis, cut_at_frame, cut_base, cut_behind, split_neighbour
 from radar_cli.masks.on_rim import cut_on_rim
 from radar_cli.masks.pipeline import (
@@ -150,6 +150,42 @@ def remove_stand(mask: np.ndarray, image: np.ndarray) -> tuple[np.ndarray, bool]
     return main_component(mask & ~stand), True
 
 
+def fill_painted_holes(mask: np.ndarray) -> np.ndarray:
+    """Fill the holes of a located object that lie deep inside it, across its axis: backdrop is seen through a
+    vessel only between a handle and the body, off the axis (a thick handle's loop can lie deep inside the
+    outline) or near the outline (a handle arching over the mouth). A hole the axis crosses whose every pixel
+    is at least GAP_DEPTH of the object's width inside its outer outline is paint of the backdrop's colour (a
+    light figure on a greyscale plate), which GrabCut took for backdrop.
+
+    Args:
+        mask: n x n bool located object.
+
+    Returns:
+        n x n bool mask with those holes filled.
+    """
+    cols = np.nonzero(mask.any(0))[0]
+    if len(cols) < 10:
+        return mask
+    solid = fill_holes(mask)
+    holes = solid & ~mask
+    if not holes.any():
+        return mask
+    depth = cv2.distanceTransform(np.pad(solid, 1).astype(np.uint8), cv2.DIST_L2, 3)[1:-1, 1:-1]
+    tilt, axis = find_axis(solid)
+    turn = upright_rotation(solid, tilt)
+    count, labels = cv2.connectedComponents(holes.astype(np.uint8), connectivity=4)
+    filled = mask.copy()
+    for i in range(1, count):
+        part = labels == i
+        if depth[part].min() < GAP_DEPTH * (cols[-1] - cols[0] + 1):
+            continue
+        py, px = np.nonzero(part)
+        upright_x = turn[0, 0] * px + turn[0, 1] * py + turn[0, 2]
+        if upright_x.min() <= axis + 0.5 <= upright_x.max() + 1:
+            filled |= part
+    return filled
+
+
 def open_gaps(mask: np.ndarray, image: np.ndarray, outside: np.ndarray | None = None) -> np.ndarray:
     """Take out of a located object the backdrop seen between a handle and the body: patches of the object
     whose colour the backdrop around it explains, near its outline and beside the vessel's axis (a patch of
@@ -226,7 +262,8 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
             raise InputError(f"{name}: no object stands out from the backdrop; crop it square or use --crop none")
         found = detections[0]
         refined = refine_detection(rgb, found, settings)
-        refined = replace(refined, mask=grow_sheen(refined.mask, refined.image, refined.outside))  # glaze's band
+        # the glaze's band along the flanks given back, paint of the backdrop's colour filled in
+        refined = replace(refined, mask=fill_painted_holes(grow_sheen(refined.mask, refined.image, refined.outside)))
     mask, neighbour = cut_behind(refined.mask)
     if not neighbour:
         mask, neighbour = split_neighbour(mask)

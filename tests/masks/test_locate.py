@@ -9,7 +9,7 @@ import pytest
 from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
 from radar_cli.masks.appendages import symmetric_core
-from radar_cli.masks.locate import locate_object, open_gaps, remove_stand
+from radar_cli.masks.locate import fill_painted_holes, locate_object, open_gaps, remove_stand
 from radar_cli.masks.refine import iou
 from radar_cli.masks.synthetic import composite, render_vases
 from radar_cli.masks.variants import KINDS, Variant, make_variant, with_handles
@@ -117,6 +117,19 @@ def test_backdrop_between_a_hugging_handle_and_the_body_is_opened() -> None:
     decorated = image.copy()
     decorated[90:110, 90:110] = 200  # a backdrop-coloured patch on the axis is the vessel's own
     assert open_gaps(body, decorated)[90:110, 90:110].all()
+
+
+def test_paint_of_the_backdrops_colour_deep_inside_is_filled_and_a_handles_loop_is_not() -> None:
+    y, x = np.mgrid[0:256, 0:256]
+    body = ((x - 128) / 70.0) ** 2 + ((y - 140) / 90.0) ** 2 <= 1  # 140 px wide
+    figure = (np.abs(x - 128) <= 15) & (np.abs(y - 140) <= 40)  # a light figure GrabCut took for backdrop
+    assert (fill_painted_holes(body & ~figure) == body).all()
+    loop = (np.hypot(x - 205, y - 140) <= 22) & ~(np.hypot(x - 205, y - 140) <= 12)  # a ring handle on the flank
+    hole = np.hypot(x - 205, y - 140) <= 12
+    with_handle = (body | loop) & ~hole
+    assert (fill_painted_holes(with_handle) == with_handle).all()  # backdrop seen through, near the outline
+    near = (np.abs(x - 68) <= 4) & (np.abs(y - 140) <= 20)  # a patch 6 px inside the flank: not filled
+    assert (fill_painted_holes(body & ~near) == (body & ~near)).all()
 
 
 def test_a_plain_solid_has_no_appendages(sources: list) -> None:
