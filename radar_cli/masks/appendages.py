@@ -132,7 +132,7 @@ def _outer_extents(mask: np.ndarray, axis: float) -> tuple[np.ndarray, np.ndarra
     return np.where(np.isfinite(left), left, np.nan), np.where(np.isfinite(right), right, np.nan)
 
 
-def _runs_of(flags: np.ndarray, length: int) -> np.ndarray:
+def runs_of(flags: np.ndarray, length: int) -> np.ndarray:
     """`flags` (bool, n) kept only in runs of at least `length` consecutive True."""
     padded = np.concatenate([[0], flags.astype(np.int8), [0]])
     starts, ends = np.nonzero(np.diff(padded) == 1)[0], np.nonzero(np.diff(padded) == -1)[0]
@@ -158,8 +158,8 @@ def _handle_plates(mask: np.ndarray, axis: float, left: np.ndarray, right: np.nd
     window = np.arange(rows.min(), min(mask.shape[0], rows.min() + int(round(SPIKE_SPAN * height))))
     run = max(2, int(round(PLATE_BELOW[1] * height)))  # a handle: longer than a ragged or lopsided plate
     kept_l, kept_r = np.fmin(left, limit), np.fmin(right, limit)  # what the core keeps on each side so far
-    apart = np.stack([_runs_of(outer_l[window] > kept_l[window] + 1.0, run),
-                      _runs_of(outer_r[window] > kept_r[window] + 1.0, run)])  # 2 x n: beside a handle
+    apart = np.stack([runs_of(outer_l[window] > kept_l[window] + 1.0, run),
+                      runs_of(outer_r[window] > kept_r[window] + 1.0, run)])  # 2 x n: beside a handle
     joined = np.nonzero(~apart.any(0))[0]  # neither: the plates, the rim
     if len(joined) == 0:
         return out

@@ -150,6 +150,14 @@ def remove_stand(mask: np.ndarray, image: np.ndarray) -> tuple[np.ndarray, bool]
     return main_component(mask & ~stand), True
 
 
+def across_axis(part: np.ndarray, turn: np.ndarray, axis: float) -> bool:
+    """Whether a part (n x n bool) of an object spans its axis: the column `axis` of the object turned upright by
+    `turn` (2 x 3 affine, `upright_rotation`) lies within the part's upright columns."""
+    py, px = np.nonzero(part)
+    upright_x = turn[0, 0] * px + turn[0, 1] * py + turn[0, 2]
+    return bool(upright_x.min() <= axis + 0.5 <= upright_x.max() + 1)
+
+
 def fill_painted_holes(mask: np.ndarray) -> np.ndarray:
     """Fill the holes of a located object that lie deep inside it, across its axis: backdrop is seen through a
     vessel only between a handle and the body, off the axis (a thick handle's loop can lie deep inside the
@@ -179,9 +187,7 @@ def fill_painted_holes(mask: np.ndarray) -> np.ndarray:
         part = labels == i
         if depth[part].min() < GAP_DEPTH * (cols[-1] - cols[0] + 1):
             continue
-        py, px = np.nonzero(part)
-        upright_x = turn[0, 0] * px + turn[0, 1] * py + turn[0, 2]
-        if upright_x.min() <= axis + 0.5 <= upright_x.max() + 1:
+        if across_axis(part, turn, axis):
             filled |= part
     return filled
 
@@ -228,9 +234,7 @@ def open_gaps(mask: np.ndarray, image: np.ndarray, outside: np.ndarray | None = 
         part = labels == i
         if depth[part].min() > GAP_DEPTH * width:
             continue
-        py, px = np.nonzero(part)
-        upright_x = turn[0, 0] * px + turn[0, 1] * py + turn[0, 2]
-        if upright_x.min() <= axis + 0.5 <= upright_x.max() + 1:
+        if across_axis(part, turn, axis):
             continue
         gaps |= part
     return main_component(mask & ~gaps) if gaps.any() else mask

@@ -15,6 +15,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from radar_cli.masks.appendages import runs_of
 from radar_cli.masks.detect import fit_backdrop
 from radar_cli.masks.refine import row_extents
 
@@ -65,16 +66,7 @@ def _steady(edge: np.ndarray, grow: np.ndarray, sign: int, run: int) -> np.ndarr
     """R int growth kept only on runs of at least `run` grown rows, its new outline (R columns `edge` moved by
     `sign` x `grow`) then the running median over 5 rows, on those runs only (no staircase where neighbouring rows
     stop at different pixels)."""
-    grown = grow > 0
-    keep = np.zeros_like(grown)
-    start = None
-    for i, g in enumerate([*grown, False]):
-        if g and start is None:
-            start = i
-        elif not g and start is not None:
-            if i - start >= run:
-                keep[start:i] = True
-            start = None
+    keep = runs_of(grow > 0, run)
     outline = (edge + sign * np.where(keep, grow, 0)).astype(np.float32).reshape(-1, 1)
     smooth = cv2.medianBlur(outline, 5).ravel()  # on one column: the median of 5 rows
     return np.where(keep, np.maximum(sign * (smooth - edge), 0), 0).astype(int)
