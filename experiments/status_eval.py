@@ -22,7 +22,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from radar_cli.derender.export.likeness import highlight_excess, luminance
+from radar_cli.derender.export.likeness import glaring_highlights, highlight_excess, luminance
 from radar_cli.derender.export.quality import fit_scores, judge, psnr
 from radar_cli.derender.export.renders import ViewRenderer
 from radar_cli.derender.run.state import read_state
@@ -59,7 +59,8 @@ def rescore(folder: Path) -> dict:
 
 def appearance(folder: Path) -> dict[str, float]:
     """How true recon.png and the albedo are to the photo inside the silhouette: the share of pixels the
-    reconstruction draws much brighter (invented highlights), its PSNR, and the correlation of the albedo
+    reconstruction draws much brighter (invented highlights), the share it draws far brighter away from the
+    outline (white spots, `glaring_highlights`), its PSNR, and the correlation of the albedo
     (albedo_rendered.png) with the photo's highlight map (the photo's luminance above its 15 px median: the
     studio's reflections; near 0 when they left the albedo)."""
     photo, recon = read_image(folder / INPUT_FILE), read_image(folder / RECON_FILE)
@@ -68,7 +69,8 @@ def appearance(folder: Path) -> dict[str, float]:
     lum = luminance(photo)
     highlights = np.clip(lum - cv2.medianBlur((lum * 255).astype(np.uint8), 15) / 255.0, 0, None)[sil]
     corr = np.corrcoef(highlights, luminance(albedo)[sil])[0, 1] if highlights.std() > 0 else 0.0
-    return {"brighter": highlight_excess(photo, recon, sil), "psnr": psnr(recon[sil], photo[sil]),
+    return {"brighter": highlight_excess(photo, recon, sil), "white_spots": glaring_highlights(photo, recon, sil),
+            "psnr": psnr(recon[sil], photo[sil]),
             "albedo_vs_highlights": float(corr)}
 
 
@@ -183,7 +185,7 @@ def main() -> None:
               ", ".join(f"{name} {value:.2f}" for value, name in sorted(values, reverse=True)[:6]))
     for group, rows in sorted(looks.items()):
         means = {k: np.mean([r[k] for r in rows]) for k in rows[0]}
-        print(f"{group}: " + ", ".join(f"{k} {v:.3f}" for k, v in means.items()))
+        print(f"{group}: " + ", ".join(f"{k} {v:.4f}" for k, v in means.items()))
 
 
 if __name__ == "__main__":

@@ -46,6 +46,7 @@ def test_a_good_result_is_ok() -> None:
     ({"cut_edges": ["top"]}, "review", "cuts off the object's top"),
     ({"cut_edges": ["left", "right"]}, "review", "cuts off both sides"),
     ({"face": 0.4}, "review", "a face looks out of the object"),
+    ({"glaring_highlights": 0.02}, "review", "white highlights"),
     ({"silhouette_iou": None, "symmetry": None, "silhouette_area": None}, "review", "no silhouette"),
 ])
 def test_each_score_can_demote(change: dict, status: str, words: str) -> None:
@@ -208,6 +209,25 @@ def test_invented_highlights_are_flagged() -> None:
     recon[ys[blob], xs[blob]] = 255  # a white highlight over a fifth of the object the photo does not have
     status, reasons = _judged(photo, sil, sil, recon)
     assert status == "review" and any("highlights" in r for r in reasons), reasons
+
+
+def test_a_white_spot_the_photo_does_not_have_is_flagged_and_a_bright_limb_is_not() -> None:
+    """A white spot over 1 % of the object (too small for `highlight_excess`) sends it to review; the same area
+    brightened along the outline (where drawn and photographed outlines part, and a glaze reflects the studio)
+    does not."""
+    photo, sil = _vase_on_white()
+    photo = np.where(sil[..., None], photo // 4, photo).astype(np.uint8)  # a dark glaze
+    ys, xs = np.nonzero(sil)
+    spot, limb = photo.copy(), photo.copy()
+    near = (ys - ys.mean()) ** 2 + (xs - xs.mean()) ** 2
+    inside = np.argsort(near)[: int(0.01 * len(ys))]
+    spot[ys[inside], xs[inside]] = 255
+    edge = sil & ~np.pad(sil[1:-1, 1:-1] & sil[:-2, 1:-1] & sil[2:, 1:-1] & sil[1:-1, :-2] & sil[1:-1, 2:], 1)
+    limb[edge] = 255
+    assert edge.sum() >= 0.01 * sil.sum()
+    status, reasons = _judged(photo, sil, sil, spot)
+    assert status == "review" and any("white highlights" in r for r in reasons), reasons
+    assert _judged(photo, sil, sil, limb)[0] == "ok"
 
 
 def test_a_view_into_the_mouth_is_not_ok() -> None:

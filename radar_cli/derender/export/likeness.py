@@ -10,6 +10,13 @@ import numpy as np
 
 BRIGHTER = 0.15
 """A recon pixel this much brighter than the photo's (luminance, 0..1) is a highlight the photo does not have."""
+GLARING = 0.3
+"""... and this much brighter, a white spot on the paint: on black glaze a highlight the photo shows at most as a
+grey sheen (the lighting fit's lobe drawn where one paint varies, and divided out of the albedo as a dark
+blotch that every relit view repeats)."""
+LIMB = 0.025
+"""White spots are not counted this close to the outline (share of the object's width): the drawn and the
+photographed outline part there by a pixel or two, and a glaze reflects the studio most at its limbs."""
 MIN_MOUTH_SHARE = 0.08
 """A drawn mouth covering less of the silhouette than this is not scored (a narrow neck's mouth, a sliver at a
 level pitch)."""
@@ -42,6 +49,16 @@ def highlight_excess(photo: np.ndarray, recon: np.ndarray, region: np.ndarray) -
     if not region.any():
         return None
     return float(((luminance(recon) - luminance(photo))[region] > BRIGHTER).mean())
+
+
+def glaring_highlights(photo: np.ndarray, recon: np.ndarray, region: np.ndarray) -> float | None:
+    """Share of the region where the reconstruction is GLARING brighter than the photo, further than LIMB of the
+    region's width inside its outline: white spots the photo does not have (None for an empty region)."""
+    if not region.any():
+        return None
+    reach = max(1, round(LIMB * int(region.any(0).sum())))
+    inner = cv2.erode(region.astype(np.uint8), np.ones((2 * reach + 1, 2 * reach + 1), np.uint8)) > 0
+    return float(((luminance(recon) - luminance(photo))[inner] > GLARING).sum() / region.sum())
 
 
 def colour_shift(photo: np.ndarray, recon: np.ndarray, region: np.ndarray) -> float | None:

@@ -11,6 +11,7 @@ import numpy as np
 from radar_cli.derender.export.faces import face_score
 from radar_cli.derender.export.likeness import (
     colour_shift,
+    glaring_highlights,
     highlight_excess,
     mouth_error,
     rim_contrast,
@@ -86,6 +87,9 @@ class QualityLimits:
     drawn where the photo shows the outer wall: the pitch too high, or no vessel)."""
     review_highlights: float = 0.08
     """More than this share of the object drawn much brighter than the photo: review (invented highlights)."""
+    review_glare: float = 0.005
+    """More than this share of the object drawn brighter than the photo by GLARING away from its limbs
+    (`glaring_highlights`): review (a white spot the photo does not have)."""
     review_colour: float = 15.0
     """The reconstruction's mean chroma further than this from the photo's (CIELAB): review."""
     review_face: float = 0.0
@@ -177,6 +181,7 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
         "recon_psnr": _round(psnr(recon[region], photo[region]), 2) if region.any() else None,
         "mouth_error": _round(mouth_error(photo, recon, region & rendered, mouth)),
         "highlight_excess": _round(highlight_excess(photo, recon, region & rendered)),
+        "glaring_highlights": _round(glaring_highlights(photo, recon, region & rendered)),
         "colour_shift": _round(colour_shift(photo, recon, region & rendered), 2),
         "face": None if whole is None else _round(face_score(photo, whole), 3),
         "shading_range": _round(shading_range(profile)),
@@ -256,6 +261,9 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
          "the reconstruction draws the inside of the mouth where the photo shows something else ({:.2f})"),
         ("highlight_excess", lambda v: v > limits.review_highlights,
          "the reconstruction has highlights the photo does not have ({:.0%} of the object)"),
+        ("glaring_highlights", lambda v: v > limits.review_glare,
+         "white highlights the photo does not have ({:.1%} of the object drawn far brighter): the albedo may "
+         "hold dark blotches where they were taken out"),
         ("colour_shift", lambda v: v > limits.review_colour,
          "the reconstruction's colour is off the photo's ({:.0f})"),
         ("face", lambda v: v > limits.review_face,

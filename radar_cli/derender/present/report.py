@@ -17,11 +17,12 @@ SUMMARY_COLUMNS = ("object", "status", "reason", "source", "pitch", "roll", "tx"
                    "roughness", "crop_box", "model", "silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction",
                    "outline_support", "object_symmetry", "outline_residual", "foot_asymmetry", "edge_roughness",
                    "top_dome", "roundness", "rim_contrast", "shading_range", "mouth_error", "highlight_excess",
-                   "colour_shift", "face", "cut_edges", "resolution", "refine", "refine_reason", "refine_iou")
+                   "glaring_highlights", "colour_shift", "face", "cut_edges", "resolution", "refine", "refine_reason",
+                   "refine_iou")
 QUALITY_COLUMNS = ("silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction", "outline_support",
                    "object_symmetry", "outline_residual", "foot_asymmetry", "edge_roughness", "top_dome",
-                   "roundness", "rim_contrast", "shading_range", "mouth_error", "highlight_excess", "colour_shift",
-                   "face")
+                   "roundness", "rim_contrast", "shading_range", "mouth_error", "highlight_excess",
+                   "glaring_highlights", "colour_shift", "face")
 STATUS_ORDER = {"failed": 0, "review": 1, "ok": 2}  # worst first; objects without a quality record come last
 
 
