@@ -55,6 +55,8 @@ class RefineReport:
         light_rmse: the paints' model against the unwrapped texture (display levels), fitted / network map (a
             record, not a test: on synthetic vases the true map draws the texture better than the network's on
             fewer than half, docs/refinement.md).
+        glare_scale: the factor on the specular albedo that keeps the fitted highlights under the photo
+            (derender.refine.glare; 1: they were).
         seconds: time the fit took.
     """
 
@@ -67,6 +69,7 @@ class RefineReport:
     specular: str = ""
     light: str = ""
     light_rmse: tuple[float, float] = (float("nan"), float("nan"))
+    glare_scale: float = 1.0
     seconds: float = 0.0
 
     def record(self) -> dict:
@@ -78,7 +81,8 @@ class RefineReport:
                                                             "network": clean(self.outline_px[1])},
                 "silhouette_iou": {"refined": clean(self.iou[0]), "network": clean(self.iou[1])},
                 "specular_albedo": self.specular, "light": self.light,
-                "light_rmse": {"fitted": clean(self.light_rmse[0]), "network": clean(self.light_rmse[1])}}
+                "light_rmse": {"fitted": clean(self.light_rmse[0]), "network": clean(self.light_rmse[1])},
+                "glare_scale": round(self.glare_scale, 4)}
 
 
 def silhouette_iou(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, mask: np.ndarray,
@@ -166,4 +170,4 @@ def _fit_light(refined: Decomposition, network_env: torch.Tensor, crop: np.ndarr
     if fit is None:
         return dataclasses.replace(refined, env=network_env), dataclasses.replace(report, light="kept")
     return (dataclasses.replace(refined, env=fit.env, rho=refined.rho * fit.specular_scale),
-            dataclasses.replace(report, light="fitted", light_rmse=fit.rmse))
+            dataclasses.replace(report, light="fitted", light_rmse=fit.rmse, glare_scale=fit.glare_scale))

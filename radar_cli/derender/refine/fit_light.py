@@ -32,6 +32,7 @@ import torch
 import torch.nn.functional as F
 
 from radar_cli.config import CameraConfig
+from radar_cli.derender.refine.glare import GlareConfig, dim
 from radar_cli.derender.refine.light_lobes import LobeProblem, fit_lobes
 from radar_cli.render.lighting import GAMMA, decompose, env_directions, phong_transport, tone_map
 from radar_cli.render.texture import sample_surface
@@ -64,6 +65,8 @@ class LightFitConfig:
             deg at 60).
         start_sharpness: every lobe's starting sharpness.
         min_elevation: lobes stay at or above this elevation (deg): the lights are above the horizon.
+        glare: how far the specular albedo is lowered where the fitted highlights outshine the photo
+            (derender.refine.glare; None: not lowered).
     """
 
     texels: int = 32
@@ -83,6 +86,7 @@ class LightFitConfig:
     sharpness: tuple[float, float] = (4.0, 60.0)
     start_sharpness: float = 15.0
     min_elevation: float = 0.0
+    glare: GlareConfig | None = GlareConfig()
 
 
 @dataclass(frozen=True)
@@ -96,13 +100,17 @@ class LightFit:
         texels: texels used.
         specular_scale: the factor (<= 1) on the specular albedo that keeps the highlights as bright as the
             fits drew them, the map being brought to the starting map's mean (1 where the fits drew them
-            brighter: the specular albedo is never raised here).
+            brighter: the specular albedo is never raised here), times the factor that keeps them under the
+            photo (`glare_scale`).
+        glare_scale: the part of `specular_scale` that keeps the highlights under the photo (derender.refine.glare;
+            1: they were).
     """
 
     env: torch.Tensor
     rmse: tuple[float, float]
     texels: int
     specular_scale: float = 1.0
+    glare_scale: float = 1.0
 
 
 def upsampler(coarse: tuple[int, int], size: tuple[int, int]) -> torch.Tensor:
@@ -257,7 +265,9 @@ def _fit(crop: np.ndarray, silhouette: np.ndarray, radius: torch.Tensor, height:
     # the paints take up the diffuse light's scale, the highlights do not: the map's scale that the fits found
     # is what the photo's highlights support (a photo without them: a dim map), and the specular albedo keeps it
     scale = min(1.0, float(np.median(means)) / max(float(start.mean()), 1e-12)) if means else 1.0
-    fitted = fitted * (float(start.mean()) / max(float(fitted.mean()), 1e-12))
-    rmse = (replace(texels, rho=rho * scale).rmse(fitted), texels.rmse(start.reshape(-1)))
-    return LightFit(fitted.reshape(1, *start.shape).to(env.dtype).to(env.device), rmse, int(texels.paint.numel()),
-                    scale)
+    fitted = (fitted * (float(start.mean()) / max(float(fitted.mean()), 1e-12))).reshape(start.shape)
+    glare = 1.0 if config.glare is None else dim(crop, silhouette, geo, fitted, alpha, rho * scale, camera,
+                                                   config.glare)
+    rmse = (replace(texels, rho=rho * scale * glare).rmse(fitted.reshape(-1)), texels.rmse(start.reshape(-1)))
+    return LightFit(fitted[None].to(env.dtype).to(env.device), rmse, int(texels.paint.numel()), scale * glare,
+                    glare)
