@@ -34,6 +34,7 @@ from radar_cli.results import (
     MATERIAL_FILE,
     RECON_FILE,
     SILHOUETTE_FILE,
+    SPECULAR_RENDERED_FILE,
 )
 
 MAX_PITCH, MAX_RATIO_ERROR, MIN_IOU = 8.0, 0.10, 0.85
@@ -44,6 +45,12 @@ KEPT = ("outline_support", "cut_edges", "frame_coverage", "neighbour_cut", "base
         "above_rim_rise")
 
 
+def drawn_highlight(folder: Path) -> np.ndarray | None:
+    """specular_rendered.png of an object folder (H x W uint8), None where it was not written."""
+    path = folder / SPECULAR_RENDERED_FILE
+    return read_image(path, "L") if path.is_file() else None
+
+
 def rescore(folder: Path) -> dict:
     """The quality record of a written object folder, judged again with the current scores."""
     record = json.loads((folder / MATERIAL_FILE).read_text())
@@ -51,7 +58,8 @@ def rescore(folder: Path) -> dict:
     mask = lambda name: (read_image(folder / name, "L") > 127) if (folder / name).is_file() else None  # noqa: E731
     view = ViewRenderer(read_state(folder), photo.shape[0])
     rendered, mouth = view.hits.mask[0].numpy(), view.hits.inner[0].numpy()
-    quality = {**fit_scores(photo, mask(SILHOUETTE_FILE), mask(APPENDAGES_FILE), rendered, recon, mouth),
+    highlight = drawn_highlight(folder)
+    quality = {**fit_scores(photo, mask(SILHOUETTE_FILE), mask(APPENDAGES_FILE), rendered, recon, mouth, highlight),
                **{k: record["quality"].get(k) for k in KEPT}}
     status, reasons = judge(quality)
     return {**quality, "status": status, "reasons": reasons}
@@ -69,7 +77,9 @@ def appearance(folder: Path) -> dict[str, float]:
     lum = luminance(photo)
     highlights = np.clip(lum - cv2.medianBlur((lum * 255).astype(np.uint8), 15) / 255.0, 0, None)[sil]
     corr = np.corrcoef(highlights, luminance(albedo)[sil])[0, 1] if highlights.std() > 0 else 0.0
-    return {"brighter": highlight_excess(photo, recon, sil), "white_spots": glaring_highlights(photo, recon, sil),
+    highlight = drawn_highlight(folder)
+    return {"brighter": highlight_excess(photo, recon, sil),
+            "white_spots": glaring_highlights(photo, recon, sil, highlight),
             "psnr": psnr(recon[sil], photo[sil]),
             "albedo_vs_highlights": float(corr)}
 

@@ -228,6 +228,13 @@ def test_a_white_spot_the_photo_does_not_have_is_flagged_and_a_bright_limb_is_no
     status, reasons = _judged(photo, sil, sil, spot)
     assert status == "review" and any("white highlights" in r for r in reasons), reasons
     assert _judged(photo, sil, sil, limb)[0] == "ok"
+    # with the drawn highlight known: a spot it draws counts, paint drawn off its place (no highlight) does not
+    from radar_cli.derender.export.quality import fit_scores
+
+    lit = np.zeros(sil.shape, np.uint8)
+    lit[ys[inside], xs[inside]] = 255
+    assert fit_scores(photo, sil, None, sil, spot, None, lit)["glaring_highlights"] > 0.005
+    assert fit_scores(photo, sil, None, sil, spot, None, np.zeros_like(lit))["glaring_highlights"] == 0
 
 
 def test_a_view_into_the_mouth_is_not_ok() -> None:

@@ -51,14 +51,20 @@ def highlight_excess(photo: np.ndarray, recon: np.ndarray, region: np.ndarray) -
     return float(((luminance(recon) - luminance(photo))[region] > BRIGHTER).mean())
 
 
-def glaring_highlights(photo: np.ndarray, recon: np.ndarray, region: np.ndarray) -> float | None:
+def glaring_highlights(photo: np.ndarray, recon: np.ndarray, region: np.ndarray,
+                       highlight: np.ndarray | None = None) -> float | None:
     """Share of the region where the reconstruction is GLARING brighter than the photo, further than LIMB of the
-    region's width inside its outline: white spots the photo does not have (None for an empty region)."""
+    region's width inside its outline, and (given the drawn highlight alone, H x W uint8 as specular_rendered.png,
+    or H x W x 3) where that highlight is GLARING bright itself: white spots the photo does not have, not paint
+    drawn a little off its place (None for an empty region)."""
     if not region.any():
         return None
     reach = max(1, round(LIMB * int(region.any(0).sum())))
     inner = cv2.erode(region.astype(np.uint8), np.ones((2 * reach + 1, 2 * reach + 1), np.uint8)) > 0
-    return float(((luminance(recon) - luminance(photo))[inner] > GLARING).sum() / region.sum())
+    spots = (luminance(recon) - luminance(photo) > GLARING) & inner
+    if highlight is not None:
+        spots &= (luminance(highlight) if highlight.ndim == 3 else highlight / 255.0) > GLARING
+    return float(spots.sum() / region.sum())
 
 
 def colour_shift(photo: np.ndarray, recon: np.ndarray, region: np.ndarray) -> float | None:

@@ -78,7 +78,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         write_picture(folder / APPENDAGES_FILE, prepared.appendages.astype(np.uint8) * 255)
     write_maps(folder, state, setup.render)
     real = write_meshes(folder, state, setup.geometry.n_cols, size.height_cm if size and size.known else None)
-    drawn, mouth, recon = write_renders(folder, state, side, config.view_side(side), config.views, envs)
+    drawing = write_renders(folder, state, side, config.view_side(side), config.views, envs)
     record = state.record()
     record.update({
         "source": str(item.image_path),
@@ -93,7 +93,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         "pitch_source": pitch_source,
         **({"refine": refine} if refine is not None else {}),
         "environments": sorted(envs),
-        "quality": assess_drawn(prepared, drawn, recon, mouth),
+        "quality": assess_drawn(prepared, drawing),
         **size_record(size, real),
         **(extra or {}),
     })

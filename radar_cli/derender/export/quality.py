@@ -18,7 +18,7 @@ from radar_cli.derender.export.likeness import (
     shading_profile,
     shading_range,
 )
-from radar_cli.derender.export.renders import ViewRenderer
+from radar_cli.derender.export.renders import InputDrawing, ViewRenderer, input_drawing
 from radar_cli.derender.run.inputs import Prepared
 from radar_cli.derender.run.state import ObjectState
 from radar_cli.masks.crop import outside_mask
@@ -136,17 +136,16 @@ def support(prepared: Prepared) -> float | None:
     return outline_support(prepared.photo_scene, sil, measurable)
 
 
-def scores(prepared: Prepared, rendered: np.ndarray, recon: np.ndarray, mouth: np.ndarray | None = None) -> dict:
+def scores(prepared: Prepared, drawing: InputDrawing) -> dict:
     """The numbers of the quality record.
 
     Args:
         prepared: the input, with its located silhouette (core) and appendages at the output side N.
-        rendered: N x N bool silhouette of the de-rendered solid in the input view.
-        recon: N x N x 3 uint8 reconstruction of the input (over white).
-        mouth: N x N bool, where the solid's inside is seen through its mouth (None: nowhere).
+        drawing: the de-rendered object drawn in the input view at N.
     """
     assert prepared.photo_image is not None  # Prepared sets it
-    return {**fit_scores(prepared.photo_image, prepared.photo_silhouette, prepared.appendages, rendered, recon, mouth),
+    return {**fit_scores(prepared.photo_image, prepared.photo_silhouette, prepared.appendages, drawing.solid,
+                         drawing.recon, drawing.mouth, drawing.highlight),
             "outline_support": _round(support(prepared)),
             "cut_edges": list(prepared.cut_edges),
             "frame_coverage": _round(prepared.frame_coverage),
@@ -157,13 +156,15 @@ def scores(prepared: Prepared, rendered: np.ndarray, recon: np.ndarray, mouth: n
 
 
 def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None, rendered: np.ndarray,
-               recon: np.ndarray, mouth: np.ndarray | None = None) -> dict:
+               recon: np.ndarray, mouth: np.ndarray | None = None, highlight: np.ndarray | None = None) -> dict:
     """The scores that compare the silhouette, the solid and the reconstruction (all N x N, as written in an
-    object's folder: input.png, silhouette.png, appendages.png, the solid's mask, recon.png).
+    object's folder: input.png, silhouette.png, appendages.png, the solid's mask, recon.png,
+    specular_rendered.png).
 
     Args:
         photo: N x N x 3 uint8 input. sil: N x N bool core or None. app: N x N bool appendages or None.
         rendered: N x N bool solid. recon: N x N x 3 uint8. mouth: N x N bool drawn inside of the mouth, or None.
+        highlight: N x N uint8, the drawn highlight alone (None: white spots read from the recon alone).
     """
     region = sil if sil is not None else rendered
     whole = None if sil is None else (sil if app is None else sil | app)
@@ -181,7 +182,7 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
         "recon_psnr": _round(psnr(recon[region], photo[region]), 2) if region.any() else None,
         "mouth_error": _round(mouth_error(photo, recon, region & rendered, mouth)),
         "highlight_excess": _round(highlight_excess(photo, recon, region & rendered)),
-        "glaring_highlights": _round(glaring_highlights(photo, recon, region & rendered)),
+        "glaring_highlights": _round(glaring_highlights(photo, recon, region & rendered, highlight)),
         "colour_shift": _round(colour_shift(photo, recon, region & rendered), 2),
         "face": None if whole is None else _round(face_score(photo, whole), 3),
         "shading_range": _round(shading_range(profile)),
@@ -295,20 +296,18 @@ def assess(prepared: Prepared, state: ObjectState, limits: QualityLimits = Quali
         limits: the thresholds.
     """
     view = ViewRenderer(state, prepared.side)
-    return assess_drawn(prepared, view.hits.mask[0].numpy(), view.draw(view.shading()), view.hits.inner[0].numpy(),
-                        limits)
+    shading = view.shading()
+    return assess_drawn(prepared, input_drawing(view, shading, view.draw(shading)), limits)
 
 
-def assess_drawn(prepared: Prepared, rendered: np.ndarray, recon: np.ndarray, mouth: np.ndarray | None = None,
-                 limits: QualityLimits = QualityLimits()) -> dict:
+def assess_drawn(prepared: Prepared, drawing: InputDrawing, limits: QualityLimits = QualityLimits()) -> dict:
     """The `quality` record from the object drawn in the input view: its scores, status and reasons.
 
     Args:
         prepared: the input crop and its located silhouette.
-        rendered: N x N bool silhouette of the final de-rendered solid; recon: N x N x 3 uint8 over white.
-        mouth: N x N bool, where the solid's inside is seen through the mouth (None: nowhere).
+        drawing: the final de-rendered object drawn in the input view.
         limits: the thresholds.
     """
-    record = scores(prepared, rendered, recon, mouth)
+    record = scores(prepared, drawing)
     status, reasons = judge(record, limits)
     return {"status": status, "reasons": reasons, **record}

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -104,14 +105,38 @@ def render_object(state: ObjectState, size: int, yaw_deg: float = 0.0, pitch_deg
     return view.draw(view.shading(env), yaw_deg, background)
 
 
+@dataclass(frozen=True)
+class InputDrawing:
+    """The object drawn in the input view, what the quality checks compare with the photo (all S x S).
+
+    Attributes:
+        solid: bool, the solid's hard silhouette. mouth: bool, where its inside shows through the mouth.
+        recon: uint8 x 3, the reconstruction over white. highlight: uint8, the drawn highlight alone
+            (specular_rendered.png).
+    """
+
+    solid: np.ndarray
+    mouth: np.ndarray
+    recon: np.ndarray
+    highlight: np.ndarray
+
+
 @torch.no_grad()
-def write_input_view(folder: Path, state: ObjectState, size: int) -> tuple[ViewRenderer, Shading, np.ndarray]:
+def input_drawing(view: ViewRenderer, shading: Shading, recon: np.ndarray) -> InputDrawing:
+    """The InputDrawing of a view drawn under `shading` as `recon`."""
+    s, hits = view.state, view.hits
+    highlight = _on_object(hits, tone_map(s.material.rho[:, None, None, None] * shading.specular, s.render.gamma))
+    return InputDrawing(hits.mask[0].numpy(), hits.inner[0].numpy(), recon, highlight)
+
+
+@torch.no_grad()
+def write_input_view(folder: Path, state: ObjectState, size: int) -> tuple[ViewRenderer, Shading, InputDrawing]:
     """mask.png, mask_front.png, albedo_rendered.png, normal_rendered.png, recon.png, diffuse_rendered.png and
     specular_rendered.png at the input's size.
 
     Returns:
         (the input view's renderer: its rays serve other views of the same size and pose; its shading under the
-        object's own lighting; the reconstruction, S x S x 3 uint8)."""
+        object's own lighting; what it draws)."""
     view = ViewRenderer(state, size)
     hits = view.hits
     coverage = torch.where(hits.mask, torch.ones_like(hits.sil), hits.sil)  # 1 x S x S
@@ -127,10 +152,10 @@ def write_input_view(folder: Path, state: ObjectState, size: int) -> tuple[ViewR
     shading = view.shading()
     recon = view.draw(shading)
     write_picture(folder / RECON_FILE, recon)
-    gamma, rho = state.render.gamma, state.material.rho[:, None, None, None]
-    write_picture(folder / DIFFUSE_RENDERED_FILE, _on_object(hits, tone_map(shading.diffuse, gamma)))
-    write_picture(folder / SPECULAR_RENDERED_FILE, _on_object(hits, tone_map(rho * shading.specular, gamma)))
-    return view, shading, recon
+    write_picture(folder / DIFFUSE_RENDERED_FILE, _on_object(hits, tone_map(shading.diffuse, state.render.gamma)))
+    drawing = input_drawing(view, shading, recon)
+    write_picture(folder / SPECULAR_RENDERED_FILE, drawing.highlight)
+    return view, shading, drawing
 
 
 def _on_object(hits: Hits, texture: torch.Tensor) -> np.ndarray:
@@ -223,13 +248,13 @@ def write_relit(folder: Path, view: ViewRenderer, envs: dict[str, np.ndarray]) -
 
 
 def write_renders(folder: Path, state: ObjectState, input_size: int, view_size: int, frames: int,
-                  envs: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                  envs: dict[str, np.ndarray]) -> InputDrawing:
     """Every render of one object; the turntable and relit views reuse the input view's rays at its size.
 
     Returns:
-        The input view's hard silhouette (S x S bool), where it shows the inside through the mouth (S x S bool)
-        and its reconstruction (S x S x 3 uint8), for the quality checks."""
-    input_view, shading, recon = write_input_view(folder, state, input_size)
+        What the input view draws, for the quality checks."""
+    input_view, shading, drawing = write_input_view(folder, state, input_size)
+    recon = drawing.recon
     write_picture(folder / MATERIAL_SPHERE_FILE, material_sphere(state, view_size))
     view_state = texture_for_size(state, view_size)
     known: tuple[Shading | None, np.ndarray | None]
@@ -241,4 +266,4 @@ def write_renders(folder: Path, state: ObjectState, input_size: int, view_size: 
     if frames > 0:
         write_turntable(folder, view, frames, *known)
     write_relit(folder, view, envs)
-    return input_view.hits.mask[0].numpy(), input_view.hits.inner[0].numpy(), recon
+    return drawing
