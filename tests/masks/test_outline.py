@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from radar_cli.derender.export.quality import QualityLimits, assess_drawn, support
+from radar_cli.derender.export.renders import InputDrawing
 from radar_cli.derender.run.inputs import Prepared, located_input, white_backdrop
 from radar_cli.masks.crop import CropBox
 from radar_cli.masks.outline import edge_contrast, outline_support
@@ -56,6 +57,12 @@ def test_unmeasurable_readings_are_left_out() -> None:
     assert outline_support(image, disc, np.zeros((128, 128), bool)) is None
 
 
+def _drawn_as_located(prepared) -> InputDrawing:
+    """A solid drawn exactly on the located silhouette, the photo its reconstruction, no highlight."""
+    sil = prepared.photo_silhouette
+    return InputDrawing(sil, np.zeros_like(sil), prepared.photo_image, np.zeros(sil.shape, np.uint8))
+
+
 def test_located_silhouette_is_supported_and_shifted_one_is_review(vase: tuple) -> None:
     photo, _ = vase
     prepared = located_input(photo, SIZE, "vase", resolution=256)
@@ -64,10 +71,10 @@ def test_located_silhouette_is_supported_and_shifted_one_is_review(vase: tuple) 
     moved = shifted(prepared)
     assert support(moved) < QualityLimits().review_support
     # the solid drawn exactly on the shifted silhouette, its reconstruction the input: only the outline tells
-    record = assess_drawn(moved, moved.photo_silhouette, moved.photo_image)
+    record = assess_drawn(moved, _drawn_as_located(moved))
     assert record["status"] in ("review", "failed")
     assert any("edge" in r for r in record["reasons"]), record["reasons"]
-    good = assess_drawn(prepared, prepared.photo_silhouette, prepared.photo_image)
+    good = assess_drawn(prepared, _drawn_as_located(prepared))
     assert good["outline_support"] >= 0.9 and not any("edge" in r for r in good["reasons"])
 
 
