@@ -34,10 +34,9 @@ import torch.nn.functional as F
 from radar_cli.config import CameraConfig
 from radar_cli.derender.refine.glare import GlareConfig, dim
 from radar_cli.derender.refine.light_lobes import LobeProblem, fit_lobes
+from radar_cli.derender.refine.texels import MIN_READ, read_front
 from radar_cli.render.lighting import GAMMA, decompose, env_directions, phong_transport, tone_map
-from radar_cli.render.texture import sample_surface
 from radar_cli.sor.solid import Solid
-from radar_cli.sor.surface import surface_grid
 from radar_cli.threads import torch_threads
 
 
@@ -181,23 +180,18 @@ def _texels(crop: np.ndarray, silhouette: np.ndarray, geo: Solid, start: torch.T
     (He x We float64); None when under 5% of the grid is usable."""
     g = config.texels
     dtype = torch.float64
-    image = torch.from_numpy(np.ascontiguousarray(crop)).permute(2, 0, 1)[None].to(dtype) / 255.0
-    cover = torch.from_numpy(silhouette.astype(np.float64))[None, None]
-    grid = surface_grid(geo, g, g, camera)
-    texture = sample_surface(torch.cat([image, cover], 1), grid, camera)[0].reshape(4, -1)  # 4 x g*g
-    normals, view = grid.normals[0].reshape(-1, 3), grid.view[0].reshape(-1, 3)
-    usable = (texture[3] > config.coverage) & ((normals * view).sum(-1) > config.min_facing)
-    if int(usable.sum()) < 0.05 * g * g:
+    front = read_front(crop, silhouette, geo, g, camera, config.coverage, config.min_facing, dtype)
+    if front is None:
         return None
-    shown = texture[:3, usable]  # 3 x n display
+    shown = front.shown  # 3 x n display
     directions = env_directions(start.shape[0], start.shape[1], dtype=dtype)
-    kd, ks = phong_transport(normals[usable], view[usable], *directions, alpha)
+    kd, ks = phong_transport(front.normals, front.view, *directions, alpha)
     diffuse, specular = kd @ start.reshape(-1), ks @ start.reshape(-1)  # n each
     divided = decompose(shown[None, :, None], diffuse[None, None], specular[None, None],
                         torch.tensor([rho], dtype=dtype), GAMMA)[0, :, 0]  # 3 x n linear
     labels = torch.from_numpy(paint_labels((divided ** (1 / GAMMA)).T.numpy(), config))
     keep = labels >= 0
-    if int(keep.sum()) < 0.05 * g * g:
+    if int(keep.sum()) < MIN_READ * g * g:
         return None
     _, paint = torch.unique(labels[keep], return_inverse=True)  # n paint indices 0..P-1
     shown = shown[:, keep]

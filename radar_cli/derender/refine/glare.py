@@ -18,10 +18,9 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig
+from radar_cli.derender.refine.texels import read_front
 from radar_cli.render.lighting import GAMMA, env_directions, phong_transport
-from radar_cli.render.texture import sample_surface
 from radar_cli.sor.solid import Solid
-from radar_cli.sor.surface import surface_grid
 
 LUMA = (0.299, 0.587, 0.114)
 
@@ -78,20 +77,13 @@ class _Surface:
 
 def _surface(crop: np.ndarray, silhouette: np.ndarray, geo: Solid, env_shape: tuple[int, int], alpha: float,
              camera: CameraConfig, config: GlareConfig) -> _Surface | None:
-    """The crop unwrapped at the shape onto the check's texels; None where fewer than 5% are read."""
-    g, dtype = config.texels, torch.float32
-    image = torch.from_numpy(np.ascontiguousarray(crop)).permute(2, 0, 1)[None].to(dtype) / 255.0
-    cover = torch.from_numpy(silhouette.astype(np.float32))[None, None]
-    grid = surface_grid(geo, g, g, camera)
-    texture = sample_surface(torch.cat([image, cover], 1), grid, camera)[0].reshape(4, -1)  # 4 x g*g
-    normals, view = grid.normals[0].reshape(-1, 3), grid.view[0].reshape(-1, 3)
-    facing = (normals * view).sum(-1)
-    read = (texture[3] > config.coverage) & (facing > config.min_facing)
-    if int(read.sum()) < 0.05 * g * g:
+    """The crop unwrapped at the shape onto the check's texels; None where too few are read."""
+    dtype = torch.float32
+    front = read_front(crop, silhouette, geo, config.texels, camera, config.coverage, config.min_facing, dtype)
+    if front is None:
         return None
-    _, ks = phong_transport(normals[read], view[read], *env_directions(*env_shape, dtype=dtype), alpha)
-    shown = texture[:3, read]
-    return _Surface(ks, shown ** GAMMA, shown, facing[read])
+    _, ks = phong_transport(front.normals, front.view, *env_directions(*env_shape, dtype=dtype), alpha)
+    return _Surface(ks, front.shown ** GAMMA, front.shown, front.facing)
 
 
 def dim(crop: np.ndarray, silhouette: np.ndarray, geo: Solid, env: torch.Tensor, alpha: float, rho: float,
