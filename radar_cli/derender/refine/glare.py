@@ -18,11 +18,10 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig
+from radar_cli.derender.export.likeness import LUMA
 from radar_cli.derender.refine.texels import read_front
 from radar_cli.render.lighting import GAMMA, env_directions, phong_transport
 from radar_cli.sor.solid import Solid
-
-LUMA = (0.299, 0.587, 0.114)
 
 
 @dataclass(frozen=True)
@@ -68,7 +67,7 @@ class _Surface:
         """Weighted share of the texels whose highlight under `env` (He x We) outshines the photo by `glaring`.
         Drawn, a texel is the photo or the highlight, whichever is brighter per channel (the divided albedo is
         the photo less the highlight, at least 0)."""
-        luma = torch.tensor(LUMA, dtype=self.linear.dtype)
+        luma = torch.from_numpy(LUMA).to(self.linear.dtype)
         highlight = rho * (self.ks @ env.reshape(-1).to(self.ks.dtype))  # n
         drawn = torch.maximum(self.linear, highlight[None]) ** (1 / GAMMA)
         over = (luma @ drawn - luma @ self.shown) > glaring
