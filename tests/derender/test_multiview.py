@@ -157,6 +157,14 @@ def test_a_multiview_folder_with_an_unreadable_photo_goes_on(tmp_path: Path, pre
     assert not views["broken.jpg"]["used"] and "unreadable" in views["broken.jpg"]["reason"]
     assert sum(v["used"] for v in views.values()) >= 2
     assert (out / "pot" / "coverage.png").is_file()
+    report = (out / "failures.csv").read_bytes()
+    # run again: the finished object is skipped, its unread photo still a failure (failures.csv, a non-zero exit)
+    again = derender([tmp_path / "in"], predictor, DerenderOptions(out=out, export=ExportConfig(views=2,
+                                                                                                view_size=32)),
+                     say=lines.append)
+    assert again.skipped == ["pot"] and not again.done
+    assert again.failures == summary.failures
+    assert (out / "failures.csv").read_bytes() == report
 
 
 @pytest.mark.slow  # about 35 s on a busy 2-core machine

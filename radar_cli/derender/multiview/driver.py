@@ -6,6 +6,7 @@ with the fused albedo, coverage.png, a picture per view (views/) and material.js
 from __future__ import annotations
 
 import dataclasses
+import json
 from pathlib import Path
 from typing import Callable
 
@@ -28,7 +29,7 @@ from radar_cli.derender.run.inputs import (
 )
 from radar_cli.derender.run.predictor import Predictor
 from radar_cli.errors import InputError, RadarError
-from radar_cli.results import COVERAGE_FILE
+from radar_cli.results import COVERAGE_FILE, MATERIAL_FILE
 from radar_cli.sizes import ObjectSize
 from radar_cli.threads import thread_map
 
@@ -42,6 +43,30 @@ def same_side(prepared: Prepared, side: int) -> Prepared:
     return dataclasses.replace(prepared, photo_image=image(prepared.photo_image),
                                photo_scene=image(prepared.photo_scene),
                                photo_silhouette=mask(prepared.photo_silhouette), appendages=mask(prepared.appendages))
+
+
+UNREADABLE = "unreadable"  # a view's `reason` in material.json when its photo could not be read: "unreadable (...)"
+
+
+def left_out(source: str, problem: str, name: str) -> Failure:
+    """The Failure of a photo that the object `name` was fitted without (`problem`: why it could not be read)."""
+    return Failure(source, f"{problem}; left out, {name} goes on with its other views")
+
+
+def recorded_left_out(folder: Path, name: str) -> list[Failure]:
+    """The Failures of the photos a finished multi-view object (folder/material.json) was fitted without because
+    they could not be read, as its run reported them: a run that skips the object reports them again, so that
+    failures.csv keeps them and the run still exits non-zero. None if the record cannot be read."""
+    try:
+        views = json.loads((folder / MATERIAL_FILE).read_text()).get("views", [])
+    except (OSError, ValueError, AttributeError):
+        return []
+    failures = []
+    for view in views if isinstance(views, list) else []:
+        reason = view.get("reason") if isinstance(view, dict) else None
+        if isinstance(reason, str) and reason.startswith(f"{UNREADABLE} (") and reason.endswith(")"):
+            failures.append(left_out(str(view.get("source", "")), reason[len(UNREADABLE) + 2 : -1], name))
+    return failures
 
 
 def read_views(item: InputItem, size: int, crop: CropMode, backdrop: Backdrop, resolution: Resolution,
@@ -58,10 +83,10 @@ def read_views(item: InputItem, size: int, crop: CropMode, backdrop: Backdrop, r
     for path, prepared in zip(item.views, thread_map(read, item.views, workers)):
         if isinstance(prepared, RadarError):
             problem = str(prepared).removeprefix(f"{path}: ")
-            failure = Failure(str(path), f"{problem}; left out, {item.name} goes on with its other views")
+            failure = left_out(str(path), problem, item.name)
             say(failure.line())
             failures.append(failure)
-            views.append(ViewFit(str(path), None, reason=f"unreadable ({problem})"))
+            views.append(ViewFit(str(path), None, reason=f"{UNREADABLE} ({problem})"))
         else:
             views.append(ViewFit(str(path), prepared))
     readable = [v for v in views if v.prepared is not None]

@@ -19,7 +19,7 @@ from tqdm import tqdm
 
 from radar_cli.derender.export.environments import builtin_environments, env_name, load_environment
 from radar_cli.derender.export.object_folder import ExportConfig, export_object, is_complete
-from radar_cli.derender.multiview.driver import derender_views
+from radar_cli.derender.multiview.driver import derender_views, recorded_left_out
 from radar_cli.derender.present.report import write_report
 from radar_cli.derender.run.inputs import (
     DEFAULT_RESOLUTION,
@@ -147,6 +147,10 @@ def _pending(batch: list[InputItem], out: Path, overwrite: bool, summary: BatchS
         if is_complete(out / item.name) and not overwrite:
             summary.skipped.append(item.name)
             say(f"{item.name}: skipped, {out / item.name} exists (use --overwrite to redo it)")
+            if item.multiview:  # the photos it was fitted without stay failures
+                for failure in recorded_left_out(out / item.name, item.name):
+                    summary.failures.append(failure)
+                    say(failure.line())
         else:
             todo.add(item.name)
             remove_stale_temps(out / item.name)  # this share's own object: whatever a killed run was writing
