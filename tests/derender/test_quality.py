@@ -41,6 +41,7 @@ def test_a_good_result_is_ok() -> None:
     ({"foot_asymmetry": 0.05}, "review", "not a foot's level arc"),
     ({"edge_roughness": 0.002}, "review", "lower outline is jagged"),
     ({"top_dome": 0.25}, "review", "dome above a neck"),
+    ({"base_width": 0.16, "base_spread": 1.0}, "review", "narrow stem"),
     ({"above_rim": 0.14, "above_rim_rise": 0.1}, "review", "stands on the rim"),
     ({"above_rim": 0.05, "above_rim_rise": 0.4}, "review", "stands on the rim"),
     ({"cut_edges": ["top"]}, "review", "cuts off the object's top"),
@@ -58,6 +59,11 @@ def test_a_foot_or_flank_on_the_frame_alone_is_ok() -> None:
     """A vessel standing on the photo's bottom edge or touching a side shows its whole outline: ok."""
     assert judge({**GOOD, "cut_edges": ["bottom", "right"], "above_rim": 0.03,
                   "above_rim_rise": 0.19}) == ("ok", [])
+
+
+def test_a_narrow_foot_that_spreads_is_a_foot() -> None:
+    assert judge({**GOOD, "base_width": 0.16, "base_spread": 1.5}) == ("ok", [])
+    assert judge({**GOOD, "base_width": 0.35, "base_spread": 1.0}) == ("ok", [])
 
 
 def test_whole_frame_with_a_good_fit_is_still_failed() -> None:

@@ -1,6 +1,6 @@
 """The whole-object scores of masks.quality: how far a solid's outline is off a silhouette, how round a
 silhouette is, how uneven or jagged its lower outline is, whether its top closes in a dome, how much of it
-stands on the rim left out of the core."""
+stands on the rim left out of the core, how narrow it ends below."""
 
 from __future__ import annotations
 
@@ -8,7 +8,14 @@ import cv2
 import numpy as np
 
 from radar_cli.masks.appendages import above_rim
-from radar_cli.masks.quality import edge_roughness, foot_asymmetry, outline_residual, roundness, top_dome
+from radar_cli.masks.quality import (
+    edge_roughness,
+    foot_asymmetry,
+    outline_residual,
+    roundness,
+    stem_base,
+    top_dome,
+)
 
 
 def _box(shift: int = 0) -> np.ndarray:
@@ -108,6 +115,31 @@ def test_a_head_on_a_neck_is_a_dome_and_an_open_mouth_is_not() -> None:
     assert top_dome(_flask("head", 1.25)) > 0.16
     assert top_dome(_flask("head", 0.6)) < 0.1
     assert top_dome(_vase()) == 0.0  # no neck: the widest rows are the body's
+
+
+def _bowl_on_stem(foot: int) -> np.ndarray:
+    """A wide bowl (half-width 80) on a stem of half-width 12 that ends below in a foot of half-width `foot`
+    (12: the stem broken off, no foot)."""
+    mask = np.zeros((200, 200), np.uint8)
+    cv2.ellipse(mask, (100, 40), (80, 70), 0, 0, 180, 1, -1)
+    cv2.rectangle(mask, (88, 100), (112, 170), 1, -1)
+    cv2.ellipse(mask, (100, 170), (foot, 4), 0, 0, 360, 1, -1)
+    mask[:40] = 0
+    return mask > 0
+
+
+def test_a_stem_broken_off_ends_narrow_and_a_foot_spreads() -> None:
+    broken = stem_base(_bowl_on_stem(12))
+    assert broken is not None and broken[0] < 0.2 and broken[1] < 1.1, broken
+    footed = stem_base(_bowl_on_stem(40))
+    assert footed is not None and footed[0] >= 0.45 and footed[1] > 2.0, footed  # a spreading foot
+    vase = stem_base(_vase())
+    assert vase is not None and vase[0] > 0.4, vase  # a bellied vase on its foot
+    disc = np.zeros((200, 200), np.uint8)
+    cv2.circle(disc, (100, 100), 70, 1, -1)
+    round_bottom = stem_base(disc > 0)
+    assert round_bottom is not None and round_bottom[0] > 0.5, round_bottom  # an aryballos's round bottom
+    assert stem_base(np.zeros((10, 10), bool)) is None
 
 
 def test_what_stands_on_the_rim_is_measured_against_the_vessel() -> None:

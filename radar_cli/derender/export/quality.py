@@ -30,6 +30,7 @@ from radar_cli.masks.quality import (
     outline_residual,
     roundness,
     sor_score,
+    stem_base,
     top_dome,
 )
 from radar_cli.masks.refine import iou
@@ -75,6 +76,11 @@ class QualityLimits:
     review_dome: float = 0.13
     """The object's top closing in a dome above a neck over more than this share of the dome's width
     (`top_dome`): review (a head, a stopper or a knob on a lid, not a mouth)."""
+    review_base_width: float = 0.24
+    """The object's lowest tenth at most this share of its width (`base_width`) ..."""
+    review_base_spread: float = 1.1
+    """... and spreading less than this from the stem above it (`base_spread`): review (a stem broken off, not a
+    foot)."""
     review_roundness: float = 0.9
     """The object's silhouette this close to a filled ellipse or closer, with a lit rim round a dark inside
     (`review_rim`): review (a view into the mouth from above, not a side view)."""
@@ -170,6 +176,7 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
     whole = None if sil is None else (sil if app is None else sil | app)
     mouth = np.zeros_like(rendered) if mouth is None else mouth
     profile = shading_profile(photo, region, rendered)
+    base = None if sil is None else stem_base(sil)
     return {
         "silhouette_iou": None if sil is None else _round(iou(rendered, sil)),
         "symmetry": None if sil is None else _round(sor_score(sil)),
@@ -178,6 +185,8 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
         "foot_asymmetry": None if whole is None else _round(foot_asymmetry(whole, rendered)),
         "edge_roughness": None if whole is None else _round(edge_roughness(whole, rendered), 5),
         "top_dome": None if sil is None else _round(top_dome(sil)),
+        "base_width": None if base is None else _round(base[0]),
+        "base_spread": None if base is None else _round(base[1]),
         "roundness": None if whole is None else _round(roundness(whole)),
         "recon_psnr": _round(psnr(recon[region], photo[region]), 2) if region.any() else None,
         "mouth_error": _round(mouth_error(photo, recon, region & rendered, mouth)),
@@ -249,6 +258,10 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
         ("top_dome", lambda v: v > limits.review_dome,
          "the top closes in a dome above a neck ({:.2f} of its width deep), not an open mouth: a head, a stopper "
          "or a lid's knob - is it turned?"),
+        ("base_width", lambda v: v < limits.review_base_width and (
+            record.get("base_spread") or 0) < limits.review_base_spread,
+         "the object ends below in a narrow stem ({:.2f} of its width) that does not spread into a foot: broken "
+         "off, or a toe made for a stand?"),
         ("above_rim", lambda v: v > limits.review_above_rim or (v > limits.review_above_rim_rise[0] and (
             record.get("above_rim_rise") or 0) > limits.review_above_rim_rise[1]),
          "something stands on the rim and is left out of the solid ({:.2f} of the vessel's size): a lid, a "
