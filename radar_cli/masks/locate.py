@@ -14,7 +14,15 @@ from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
 from radar_cli.masks.appendages import Core, above_rim, find_axis, symmetric_core, upright_rotation
 from radar_cli.masks.border import frame_inset
-from radar_cli.masks.detect import WORK_SIDE, Detection, detect, downscale, fill_holes, fit_backdrop
+from radar_cli.masks.detect import (
+    MIN_AREA_FRAC,
+    WORK_SIDE,
+    Detection,
+    detect,
+    downscale,
+    fill_holes,
+    fit_backdrop,
+)
 from radar_cli.masks.neighbours import base_off_axis, cut_at_frame, cut_base, cut_behind, split_neighbour
 from radar_cli.masks.on_rim import cut_on_rim
 from radar_cli.masks.pipeline import (
@@ -263,7 +271,9 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     else:
         detections = detect(rgb, thorough=True)
         if not detections:
-            raise InputError(f"{name}: no object stands out from the backdrop; crop it square or use --crop none")
+            raise InputError(f"{name}: no object stands out from the backdrop (one covering under "
+                             f"{MIN_AREA_FRAC:.0%} of the photo is taken for dust); crop the photo around it, or "
+                             "use --crop none")
         found = detections[0]
         refined = refine_detection(rgb, found, settings)
         # the glaze's band along the flanks given back, paint of the backdrop's colour filled in

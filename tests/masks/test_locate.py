@@ -141,3 +141,17 @@ def test_a_plain_solid_has_no_appendages(sources: list) -> None:
 def test_blank_photo_is_one_clear_error() -> None:
     with pytest.raises(InputError, match="blank.png"):
         locate_object(np.full((120, 90, 3), 200, np.uint8), SIZE, "blank.png")
+
+
+def test_a_vessel_under_a_hundredth_of_the_photo_is_one_clear_error(sources: list) -> None:
+    """A vessel filling under 1 % of a wide shot is taken for dust: the error says so and how to get past it."""
+    photo, truth = sources[0]
+    small, inside = photo[::2, ::2], truth[::2, ::2]
+    h, w = inside.shape
+    wide = np.full((1500, 2000, 3), 128, np.uint8)
+    wide[1000:1000 + h, 1400:1400 + w][inside] = small[inside]
+    assert inside.sum() < 0.01 * 1500 * 2000
+    with pytest.raises(InputError, match=r"wide.png: .*under 1% of the photo.*crop the photo around it"):
+        locate_object(wide, SIZE, "wide.png")
+    found = locate_object(wide[900:1300, 1300:1800], SIZE, "cropped.png")  # cropped around it: found
+    assert found.silhouette.sum() > 0.1 * SIZE * SIZE
