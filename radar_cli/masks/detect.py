@@ -23,6 +23,7 @@ import numpy as np
 
 from radar_cli.masks.border import backdrop_band, frame_padding
 from radar_cli.masks.outline import outline_support
+from radar_cli.masks.quality import sor_score
 
 WORK_SIDE = 320  # detection runs at this long edge; refinement happens later at crop resolution
 MIN_AREA_FRAC = 0.01  # components smaller than this fraction of the image are noise (labels, dust)
@@ -40,6 +41,8 @@ READING_SHARE = 0.25  # a reading whose largest object is under this share of an
 SHADING_LEAD = 0.05  # on a colour photo the reading that forgives shading wins unless beaten by this much support
 GROWTH = 1.5  # ... or unless the other reading's object is this many times as large ...
 GROWTH_SLACK = 0.02  # ... with its outline on the photo's edges nearly as well (support at most this much lower)
+SYMMETRIC_GROWTH = 1.03  # ... or unless the other reading's object is this many times as large and as symmetric
+SYMMETRY_SLACK = 0.01  # ... about an axis (its solid-of-revolution score at most this much lower)
 
 
 @dataclass(frozen=True)
@@ -282,6 +285,12 @@ def _largest_area(mask: np.ndarray) -> int:
     return int(stats[1:, cv2.CC_STAT_AREA].max()) if n > 1 else 0
 
 
+def _largest(mask: np.ndarray) -> np.ndarray:
+    """The largest 8-connected component of a bool mask (the mask itself if empty)."""
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
+    return labels == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA])) if n > 1 else mask
+
+
 def _clean(mask: np.ndarray) -> np.ndarray:
     """Close small gaps, fill holes (flood from the border), open away specks."""
     side = max(mask.shape)
@@ -366,7 +375,9 @@ def _best_reading(small: np.ndarray, read: Callable[[bool], tuple[np.ndarray, np
     forgiving reading. The strict reading also wins where its object is GROWTH times as large and its support
     at most GROWTH_SLACK lower: shade does not add half again to an object and keep its outline on sharp edges;
     a black body on a dark sweep, or a white one on a pale backdrop, that the forgiving reading took for shade
-    does.
+    does. And it wins where its object is SYMMETRIC_GROWTH times as large and its largest part at most
+    SYMMETRY_SLACK less symmetric about an axis (`quality.sor_score`): a shadow cast beside the vessel makes
+    the object lopsided, a neighbour taken in as well; the vessel's own dark lower body does not.
 
     The second reading is made only if it could win: not where the first one's object covers READING_SHARE of
     the photo (so it counts however large the other's is), its score reaches 1 (the most the other can score)
@@ -383,7 +394,10 @@ def _best_reading(small: np.ndarray, read: Callable[[bool], tuple[np.ndarray, np
     score = support + lead if area >= READING_SHARE * largest else -1.0
     strict_score = strict_support if strict_area >= READING_SHARE * largest else -1.0
     grown = strict_area >= GROWTH * area and strict_support >= support - GROWTH_SLACK
-    return (*forgiving, cleaned) if score >= strict_score and not grown else (*strict, strict_cleaned)
+    truer = strict_area >= SYMMETRIC_GROWTH * area and (
+        sor_score(_largest(strict_cleaned)) >= sor_score(_largest(cleaned)) - SYMMETRY_SLACK)
+    keep = score >= strict_score and not grown and not truer
+    return (*forgiving, cleaned) if keep else (*strict, strict_cleaned)
 
 
 def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) -> list[Detection]:
