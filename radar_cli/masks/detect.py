@@ -285,10 +285,12 @@ def _largest_area(mask: np.ndarray) -> int:
     return int(stats[1:, cv2.CC_STAT_AREA].max()) if n > 1 else 0
 
 
-def _largest(mask: np.ndarray) -> np.ndarray:
-    """The largest 8-connected component of a bool mask (the mask itself if empty)."""
+def main_component(mask: np.ndarray) -> np.ndarray:
+    """The largest 8-connected component of a bool mask."""
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
-    return labels == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA])) if n > 1 else mask
+    if n <= 2:
+        return mask.astype(bool)
+    return labels == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
 
 
 def _clean(mask: np.ndarray) -> np.ndarray:
@@ -394,9 +396,9 @@ def _best_reading(small: np.ndarray, read: Callable[[bool], tuple[np.ndarray, np
     score = support + lead if area >= READING_SHARE * largest else -1.0
     strict_score = strict_support if strict_area >= READING_SHARE * largest else -1.0
     grown = strict_area >= GROWTH * area and strict_support >= support - GROWTH_SLACK
-    truer = strict_area >= SYMMETRIC_GROWTH * area and (
-        sor_score(_largest(strict_cleaned)) >= sor_score(_largest(cleaned)) - SYMMETRY_SLACK)
-    keep = score >= strict_score and not grown and not truer
+    keep = score >= strict_score and not grown and not (  # the symmetry is read only where it can decide
+        strict_area >= SYMMETRIC_GROWTH * area
+        and sor_score(main_component(strict_cleaned)) >= sor_score(main_component(cleaned)) - SYMMETRY_SLACK)
     return (*forgiving, cleaned) if keep else (*strict, strict_cleaned)
 
 

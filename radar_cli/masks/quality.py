@@ -241,7 +241,7 @@ def stem_base(core: np.ndarray, foot: float = 0.1,
     """How wide the object ends below, and whether it spreads into a foot there: (the widest row of the lowest
     `foot` of its height over its widest row; that over the narrowest row between `stem` of the height from its
     top). A vessel stands on a foot or a base: its lowest tenth is at least 0.29 of its width on the vessels
-    measured (0.41 on the photographed ones), and a narrow foot spreads from the stem above it. A vessel broken
+    measured (0.455 on the photographed ones), and a narrow foot spreads from the stem above it. A vessel broken
     off across a narrow stem ends in the stem itself: narrow and not spreading (0.16 and 0.20 of the width,
     spreading 0.98-1.00, on the generated broken vases whose `foot_asymmetry` and `edge_roughness` read the
     short break as a foot's).

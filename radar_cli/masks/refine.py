@@ -5,7 +5,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from radar_cli.masks.detect import fill_holes
+from radar_cli.masks.detect import fill_holes, main_component
 
 INNER_BAND = 0.05  # probable-foreground band inside the rough mask, as a fraction of the object's size
 OUTER_BAND = 0.08  # probable-background band outside it
@@ -43,14 +43,6 @@ def trimap(rough: np.ndarray, sure: np.ndarray | None = None, outside: np.ndarra
     if outside is not None:
         tri[outside] = cv2.GC_BGD
     return tri
-
-
-def main_component(mask: np.ndarray) -> np.ndarray:
-    """The largest 8-connected component of a bool mask."""
-    n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
-    if n <= 2:
-        return mask.astype(bool)
-    return labels == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
 
 
 def row_extents(mask: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -56,7 +56,7 @@ def left_out(source: str, problem: str, name: str) -> Failure:
 def recorded_left_out(folder: Path, name: str) -> list[Failure]:
     """The Failures of the photos a finished multi-view object (folder/material.json) was fitted without because
     they could not be read, as its run reported them: a run that skips the object reports them again, so that
-    failures.csv keeps them and the run still exits non-zero. None if the record cannot be read."""
+    failures.csv keeps them and the run still exits non-zero. Empty if the record cannot be read."""
     try:
         views = json.loads((folder / MATERIAL_FILE).read_text()).get("views", [])
     except (OSError, ValueError, AttributeError):
