@@ -132,6 +132,23 @@ def test_paint_of_the_backdrops_colour_deep_inside_is_filled_and_a_handles_loop_
     assert (fill_painted_holes(body & ~near) == (body & ~near)).all()
 
 
+def test_a_large_figure_of_the_backdrops_grey_on_a_greyscale_plate_is_paint_and_a_handles_gap_is_not() -> None:
+    y, x = np.mgrid[0:256, 0:256]
+    body = ((x - 128) / 90.0) ** 2 + ((y - 140) / 100.0) ** 2 <= 1  # 180 px wide
+    figure = (np.abs(x - 75) <= 18) & (np.abs(y - 140) <= 45)  # off the axis, 3 px inside the flank
+    assert figure.sum() >= 0.07 * (body & ~figure).sum()
+    assert (fill_painted_holes(body & ~figure, greyscale=True) == body).all()
+    assert (fill_painted_holes(body & ~figure) == (body & ~figure)).all()  # in colour, GrabCut is trusted
+    gap = (np.abs(x - 50) <= 5) & (np.abs(y - 110) <= 25)  # a handle's gap: 2 % of the object
+    assert (fill_painted_holes(body & ~gap, greyscale=True) == (body & ~gap)).all()
+    image = np.full((256, 256, 3), 150, np.uint8)  # the backdrop's grey
+    image[body] = 60
+    image[figure] = 150  # the figure's paint, as grey as the backdrop, GrabCut's mask holding it
+    assert open_gaps(body, image, greyscale=True)[figure].all()
+    assert not open_gaps(body, image)[figure].any()  # in colour it is taken for backdrop seen through
+    assert open_gaps(body, image, paint=figure)[figure].all()  # unless filled as paint already
+
+
 def test_a_plain_solid_has_no_appendages(sources: list) -> None:
     for _, truth in sources:
         split = symmetric_core(truth)
