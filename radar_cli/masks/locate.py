@@ -68,6 +68,8 @@ class Located:
             probably kept with it where large; `neighbours.base_off_axis`).
         above_rim: what of the object stands above its rim over the mouth, left out of the core (a lid's head,
             a stopper, flowers; `appendages.above_rim`): its area over the core's, its rise over the rim's width.
+        painted_fill: on a greyscale photo, the share of the object filled in as paint of the backdrop's grey
+            (`fill_painted_holes`): where large, the outline is a guess (0 on colour photos).
     """
 
     image: np.ndarray
@@ -81,6 +83,7 @@ class Located:
     neighbour_removed: bool = False
     base_off_axis: float = 0.0
     above_rim: tuple[float, float] = (0.0, 0.0)
+    painted_fill: float = 0.0
 
     @property
     def appendage_fraction(self) -> float:
@@ -277,7 +280,7 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     top, bottom, left, right = (0, 0, 0, 0) if opaque is not None else frame_inset(rgb)
     rgb = rgb[top : rgb.shape[0] - bottom, left : rgb.shape[1] - right]  # a flat frame round it is no part
     settings = Settings(size=size, margin=margin)
-    greyscale, paint = False, None
+    greyscale, paint, painted = False, None, 0.0
     if opaque is not None:
         found = alpha_detection(opaque)
         refined = alpha_refined(rgb, opaque, found, settings)
@@ -294,6 +297,7 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
         grown = grow_sheen(refined.mask, refined.image, refined.outside)
         refined = replace(refined, mask=fill_painted_holes(grown, greyscale))
         paint = refined.mask & ~grown
+        painted = float(paint.sum() / refined.mask.sum()) if greyscale and paint.any() else 0.0
     mask, neighbour = cut_behind(refined.mask)
     if not neighbour:
         mask, neighbour = split_neighbour(mask)
@@ -310,4 +314,5 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     coverage = float(mask.sum() * k * k / (rgb.shape[0] * rgb.shape[1]))
     box = crops.CropBox(final.x0 + left, final.y0 + top, final.side)  # in the photo with its frame
     return Located(image, core, whole & ~core, box, crops.cut_edges(whole, final, rgb.shape), min(1.0, coverage),
-                   split.symmetry, stand, neighbour, base_off_axis(mask, split.core), above_rim(mask, split.core))
+                   split.symmetry, stand, neighbour, base_off_axis(mask, split.core), above_rim(mask, split.core),
+                   painted)

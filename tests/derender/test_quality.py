@@ -38,6 +38,7 @@ def test_a_good_result_is_ok() -> None:
     ({"outline_support": 0.4}, "review", "off the object's edge"),
     ({"neighbour_cut": True}, "review", "neighbouring object was cut away"),
     ({"base_off_axis": 0.3}, "review", "another object probably merged"),
+    ({"painted_fill": 0.1}, "review", "as grey as the backdrop"),
     ({"foot_asymmetry": 0.05}, "review", "not a foot's level arc"),
     ({"edge_roughness": 0.002}, "review", "lower outline is jagged"),
     ({"top_dome": 0.25}, "review", "dome above a neck"),

@@ -22,6 +22,7 @@ from radar_cli.derender.export.renders import InputDrawing, ViewRenderer, input_
 from radar_cli.derender.run.inputs import Prepared
 from radar_cli.derender.run.state import ObjectState
 from radar_cli.masks.crop import outside_mask
+from radar_cli.masks.locate import PAINT_AREA
 from radar_cli.masks.neighbours import BASE_MERGED
 from radar_cli.masks.outline import outline_support
 from radar_cli.masks.quality import (
@@ -104,6 +105,9 @@ class QualityLimits:
     review_base_off_axis: float = BASE_MERGED
     """More than this share of the located object's lowest rows off its symmetric core (`base_off_axis`):
     review (a neighbouring object, or a card in front of the foot, probably kept with it)."""
+    review_painted_fill: float = PAINT_AREA
+    """On a greyscale photo, at least this share of the object filled in as paint of the backdrop's grey
+    (`painted_fill`): review (where the painting is as grey as the backdrop, the outline is a guess)."""
     review_above_rim: float = 0.08
     """More of the object than this (its area over the core's) standing above its rim over the mouth, left out of
     the solid (`above_rim`): review (a lid's head, a stopper, a figure or flowers)."""
@@ -157,6 +161,7 @@ def scores(prepared: Prepared, drawing: InputDrawing) -> dict:
             "frame_coverage": _round(prepared.frame_coverage),
             "neighbour_cut": prepared.neighbour_cut,
             "base_off_axis": _round(prepared.base_off_axis),
+            "painted_fill": _round(prepared.painted_fill),
             "above_rim": None if prepared.above_rim is None else _round(prepared.above_rim[0]),
             "above_rim_rise": None if prepared.above_rim is None else _round(prepared.above_rim[1])}
 
@@ -288,14 +293,19 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
 
 
 def neighbour_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> list[str]:
-    """Review reasons about neighbouring objects: one was cut away from the located object (the cut may run
-    through the vessel), or one was probably kept with it."""
+    """Review reasons about what the locator had to decide: a neighbouring object was cut away from the located
+    object (the cut may run through the vessel), or one was probably kept with it; painting as grey as the
+    backdrop was taken for the vessel."""
     reasons = []
     if record.get("neighbour_cut"):
         reasons.append("a neighbouring object was cut away from it: check the outline where they touched")
     off = record.get("base_off_axis")
     if off is not None and off > limits.review_base_off_axis:
         reasons.append(f"another object probably merged into it ({off:.0%} of its lower part off the vessel's axis)")
+    painted = record.get("painted_fill")
+    if painted is not None and painted >= limits.review_painted_fill:
+        reasons.append(f"on this greyscale photo {painted:.0%} of the object is painting as grey as the backdrop, "
+                       "taken for the vessel: check the outline")
     return reasons
 
 

@@ -107,6 +107,8 @@ class Prepared:
         above_rim: what of the located object stands above its rim over the mouth, left out of the core (a
             lid's head, a stopper, flowers): its area over the core's, its rise over the rim's width; None if not
             located.
+        painted_fill: on a greyscale photo, the share of the located object filled in as paint of the
+            backdrop's grey (masks.locate.Located); None if not located.
     """
 
     image: np.ndarray
@@ -123,6 +125,7 @@ class Prepared:
     neighbour_cut: bool = False
     base_off_axis: float | None = None
     above_rim: tuple[float, float] | None = None
+    painted_fill: float | None = None
 
     def __post_init__(self) -> None:
         if self.photo_image is None:  # frozen: the network's crop is the output crop
@@ -356,7 +359,8 @@ def located_input(photo: np.ndarray, size: int, name: str, backdrop: Backdrop = 
                        appendages=resize_mask(found.appendages, side), cut_edges=found.cut_edges,
                        frame_coverage=round(found.frame_coverage, 4), neighbour_cut=found.neighbour_removed,
                        base_off_axis=round(found.base_off_axis, 4),
-                       above_rim=(round(found.above_rim[0], 4), round(found.above_rim[1], 4)))
+                       above_rim=(round(found.above_rim[0], 4), round(found.above_rim[1], 4)),
+                       painted_fill=round(found.painted_fill, 4))
     return _on_backdrop(located, backdrop)
 
 
