@@ -47,6 +47,8 @@ GAP_DISTANCE = 3.0  # object pixels this close to the backdrop model (in its noi
 GAP_LEVELS = 20.0  # ... or this close in RGB levels, Euclidean (a gap seen through the vessel is lit otherwise) ...
 GAP_MIN = 0.002  # ... seen through the object where they form a patch of at least this share of it ...
 GAP_DEPTH = 0.08  # ... that comes this close (fraction of the object's width) to its outline ...
+GAP_CONTRAST = 3.0  # ... and lies this many times as far from the object's own colour around it as from the backdrop
+GAP_AROUND = 0.05  # the object's own colour: of its pixels within this share of the window, backdrop-like ones left out
 PAINT_AREA = 0.07  # on a greyscale photo a hole this large (share of the object) is paint, wherever it lies
 
 
@@ -211,16 +213,19 @@ def fill_painted_holes(mask: np.ndarray, greyscale: bool = False) -> np.ndarray:
 
 
 def open_gaps(mask: np.ndarray, image: np.ndarray, outside: np.ndarray | None = None,
-              paint: np.ndarray | None = None, greyscale: bool = False) -> np.ndarray:
+              kept: np.ndarray | None = None, greyscale: bool = False) -> np.ndarray:
     """Take out of a located object the backdrop seen between a handle and the body: patches of the object
     whose colour the backdrop around it explains, near its outline and beside the vessel's axis (a patch of
-    the body's own decoration that matches the backdrop is rarely all three). The located mask has them filled
+    the body's own decoration that matches the backdrop is rarely all three), and whose colour lies GAP_CONTRAST
+    times as far from the object's own colour around it as from the backdrop's (a black glaze on a dark grey
+    sweep is close to the backdrop too, but closer to the glaze beside it). The located mask has them filled
     (GrabCut closes a thin gap); open, they let the handle part from the body.
 
     Args:
         mask: n x n bool located object. image: n x n x 3 uint8, the pixels it was located in.
         outside: n x n bool, the padding beyond the photo's edge (no backdrop to model there), if any.
-        paint: n x n bool, what `fill_painted_holes` filled as paint, if any: never a gap.
+        kept: n x n bool, what the locator gave back to the object on purpose (the glaze's band along the
+            flanks, `sheen.grow_sheen`; paint filled in, `fill_painted_holes`), if any: never a gap.
         greyscale: whether the photo is greyscale: a patch of PAINT_AREA of the object or more is then paint
             of the backdrop's grey, never a gap.
 
@@ -241,7 +246,9 @@ def open_gaps(mask: np.ndarray, image: np.ndarray, outside: np.ndarray | None = 
     pixels = image.astype(np.float32)
     model, noise = fit_backdrop(pixels, ring)
     dist = np.sqrt((((pixels - model) / np.maximum(noise, GAP_LEVELS / GAP_DISTANCE)) ** 2).sum(axis=2))
-    candidate = (mask & (dist < GAP_DISTANCE) & (True if paint is None else ~paint)).astype(np.uint8)
+    candidate = (mask & (dist < GAP_DISTANCE) & (True if kept is None else ~kept)).astype(np.uint8)
+    own = mask & (dist >= GAP_DISTANCE)  # the object's pixels unlike the backdrop
+    reach = max(1, round(GAP_AROUND * n))
     count, labels, stats, _ = cv2.connectedComponentsWithStats(candidate, connectivity=4)
     if count <= 1:
         return mask
@@ -259,6 +266,12 @@ def open_gaps(mask: np.ndarray, image: np.ndarray, outside: np.ndarray | None = 
             continue
         if across_axis(part, turn, axis):
             continue
+        around = (cv2.dilate(part.astype(np.uint8), np.ones((3, 3), np.uint8), iterations=reach) > 0) & own
+        if around.sum() >= 10:
+            to_object = np.linalg.norm(pixels[part] - np.median(pixels[around], axis=0), axis=1).mean()
+            to_backdrop = np.linalg.norm(pixels[part] - model[part], axis=1).mean()
+            if to_object < GAP_CONTRAST * to_backdrop:
+                continue
         gaps |= part
     return main_component(mask & ~gaps) if gaps.any() else mask
 
@@ -280,7 +293,7 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     top, bottom, left, right = (0, 0, 0, 0) if opaque is not None else frame_inset(rgb)
     rgb = rgb[top : rgb.shape[0] - bottom, left : rgb.shape[1] - right]  # a flat frame round it is no part
     settings = Settings(size=size, margin=margin)
-    greyscale, paint, painted = False, None, 0.0
+    greyscale, kept, painted = False, None, 0.0
     if opaque is not None:
         found = alpha_detection(opaque)
         refined = alpha_refined(rgb, opaque, found, settings)
@@ -295,13 +308,13 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
         # the glaze's band along the flanks given back, paint of the backdrop's colour filled in
         greyscale = is_greyscale(refined.image)
         grown = grow_sheen(refined.mask, refined.image, refined.outside)
-        refined = replace(refined, mask=fill_painted_holes(grown, greyscale))
-        paint = refined.mask & ~grown
-        painted = float(paint.sum() / refined.mask.sum()) if greyscale and paint.any() else 0.0
+        filled = fill_painted_holes(grown, greyscale)
+        painted = float((filled & ~grown).sum() / filled.sum()) if greyscale else 0.0
+        refined, kept = replace(refined, mask=filled), filled & ~refined.mask
     mask, neighbour = cut_behind(refined.mask)
     if not neighbour:
         mask, neighbour = split_neighbour(mask)
-    mask, stand = remove_stand(open_gaps(mask, refined.image, refined.outside, paint, greyscale), refined.image)
+    mask, stand = remove_stand(open_gaps(mask, refined.image, refined.outside, kept, greyscale), refined.image)
     mask, _ = cut_on_rim(mask)  # flowers, stems
     mask, framed = cut_at_frame(mask, refined.outside)  # after the stand: a plinth cut by the frame is no neighbour
     neighbour = neighbour or framed

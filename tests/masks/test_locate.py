@@ -119,6 +119,19 @@ def test_backdrop_between_a_hugging_handle_and_the_body_is_opened() -> None:
     assert open_gaps(body, decorated)[90:110, 90:110].all()
 
 
+def test_a_black_glaze_near_a_dark_backdrops_grey_is_no_gap_but_the_backdrop_past_its_handle_is() -> None:
+    mask, image, body = _hugging_handles(60)
+    image[mask] = np.where(image[mask] == 60, 60, 30)  # a black krater on a dark grey sweep
+    image[~mask] = 60
+    yy, xx = np.mgrid[0:200, 0:200]
+    sheen = body & (xx < 70) & (yy > 140) & (yy < 170)  # a grey reflection on the glaze near the flank
+    image[sheen] = 50  # 17 levels from the backdrop (a candidate), 35 from the glaze around it
+    opened = open_gaps(mask, image)
+    assert opened[sheen].all()  # closer to the glaze than GAP_CONTRAST times its distance to the backdrop
+    assert iou(symmetric_core(opened).core, body) >= 0.97  # the gaps past the handles are open
+    assert open_gaps(mask, image, kept=mask)[mask].all()  # what was given back on purpose stays
+
+
 def test_paint_of_the_backdrops_colour_deep_inside_is_filled_and_a_handles_loop_is_not() -> None:
     y, x = np.mgrid[0:256, 0:256]
     body = ((x - 128) / 70.0) ** 2 + ((y - 140) / 90.0) ** 2 <= 1  # 140 px wide
@@ -146,7 +159,7 @@ def test_a_large_figure_of_the_backdrops_grey_on_a_greyscale_plate_is_paint_and_
     image[figure] = 150  # the figure's paint, as grey as the backdrop, GrabCut's mask holding it
     assert open_gaps(body, image, greyscale=True)[figure].all()
     assert not open_gaps(body, image)[figure].any()  # in colour it is taken for backdrop seen through
-    assert open_gaps(body, image, paint=figure)[figure].all()  # unless filled as paint already
+    assert open_gaps(body, image, kept=figure)[figure].all()  # unless filled as paint already
 
 
 def test_a_plain_solid_has_no_appendages(sources: list) -> None:
