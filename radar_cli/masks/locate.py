@@ -72,6 +72,8 @@ class Located:
             a stopper, flowers; `appendages.above_rim`): its area over the core's, its rise over the rim's width.
         painted_fill: on a greyscale photo, the share of the object filled in as paint of the backdrop's grey
             (`fill_painted_holes`): where large, the outline is a guess (0 on colour photos).
+        greyscale: whether the photo is greyscale (`detect.is_greyscale` of the refinement window): the outline
+            was read from brightness alone.
     """
 
     image: np.ndarray
@@ -86,6 +88,7 @@ class Located:
     base_off_axis: float = 0.0
     above_rim: tuple[float, float] = (0.0, 0.0)
     painted_fill: float = 0.0
+    greyscale: bool = False
 
     @property
     def appendage_fraction(self) -> float:
@@ -328,4 +331,4 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     box = crops.CropBox(final.x0 + left, final.y0 + top, final.side)  # in the photo with its frame
     return Located(image, core, whole & ~core, box, crops.cut_edges(whole, final, rgb.shape), min(1.0, coverage),
                    split.symmetry, stand, neighbour, base_off_axis(mask, split.core), above_rim(mask, split.core),
-                   painted)
+                   painted, greyscale)

@@ -39,6 +39,7 @@ def test_a_good_result_is_ok() -> None:
     ({"neighbour_cut": True}, "review", "neighbouring object was cut away"),
     ({"base_off_axis": 0.3}, "review", "another object probably merged"),
     ({"painted_fill": 0.1}, "review", "as grey as the backdrop"),
+    ({"greyscale": True, "object_symmetry": 0.82}, "review", "not quite symmetric"),
     ({"foot_asymmetry": 0.05}, "review", "not a foot's level arc"),
     ({"edge_roughness": 0.002}, "review", "lower outline is jagged"),
     ({"top_dome": 0.25}, "review", "dome above a neck"),
@@ -60,6 +61,11 @@ def test_a_foot_or_flank_on_the_frame_alone_is_ok() -> None:
     """A vessel standing on the photo's bottom edge or touching a side shows its whole outline: ok."""
     assert judge({**GOOD, "cut_edges": ["bottom", "right"], "above_rim": 0.03,
                   "above_rim_rise": 0.19}) == ("ok", [])
+
+
+def test_the_same_symmetry_on_a_colour_photo_is_ok() -> None:
+    assert judge({**GOOD, "object_symmetry": 0.82}) == ("ok", [])
+    assert judge({**GOOD, "greyscale": True, "object_symmetry": 0.9}) == ("ok", [])
 
 
 def test_a_narrow_foot_that_spreads_is_a_foot() -> None:

@@ -106,6 +106,9 @@ class QualityLimits:
     """More than this share of the located object's lowest rows off its symmetric core (`base_off_axis`):
     review (a neighbouring object, or a card in front of the foot, probably kept with it)."""
     review_painted_fill: float = PAINT_AREA
+    review_greyscale_symmetry: float = 0.85
+    """On a greyscale photo, the located object less symmetric about an axis than this (`object_symmetry`):
+    review (read from brightness alone, its outline may follow painting as grey as the backdrop)."""
     """On a greyscale photo, at least this share of the object filled in as paint of the backdrop's grey
     (`painted_fill`): review (where the painting is as grey as the backdrop, the outline is a guess)."""
     review_above_rim: float = 0.08
@@ -162,6 +165,7 @@ def scores(prepared: Prepared, drawing: InputDrawing) -> dict:
             "neighbour_cut": prepared.neighbour_cut,
             "base_off_axis": _round(prepared.base_off_axis),
             "painted_fill": _round(prepared.painted_fill),
+            "greyscale": prepared.greyscale,
             "above_rim": None if prepared.above_rim is None else _round(prepared.above_rim[0]),
             "above_rim_rise": None if prepared.above_rim is None else _round(prepared.above_rim[1])}
 
@@ -295,7 +299,7 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
 def neighbour_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> list[str]:
     """Review reasons about what the locator had to decide: a neighbouring object was cut away from the located
     object (the cut may run through the vessel), or one was probably kept with it; painting as grey as the
-    backdrop was taken for the vessel."""
+    backdrop was taken for the vessel, or a greyscale photo's outline may follow such painting."""
     reasons = []
     if record.get("neighbour_cut"):
         reasons.append("a neighbouring object was cut away from it: check the outline where they touched")
@@ -306,6 +310,11 @@ def neighbour_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> 
     if painted is not None and painted >= limits.review_painted_fill:
         reasons.append(f"on this greyscale photo {painted:.0%} of the object is painting as grey as the backdrop, "
                        "taken for the vessel: check the outline")
+    symmetry = record.get("object_symmetry")
+    if (record.get("greyscale") and symmetry is not None
+            and limits.review_object_symmetry <= symmetry < limits.review_greyscale_symmetry):
+        reasons.append(f"on this greyscale photo the object as located is not quite symmetric about an axis "
+                       f"({symmetry:.2f}): its outline may follow painting as grey as the backdrop")
     return reasons
 
 

@@ -109,6 +109,7 @@ class Prepared:
             located.
         painted_fill: on a greyscale photo, the share of the located object filled in as paint of the
             backdrop's grey (masks.locate.Located); None if not located.
+        greyscale: whether the located photo is greyscale (its outline read from brightness alone).
     """
 
     image: np.ndarray
@@ -126,6 +127,7 @@ class Prepared:
     base_off_axis: float | None = None
     above_rim: tuple[float, float] | None = None
     painted_fill: float | None = None
+    greyscale: bool = False
 
     def __post_init__(self) -> None:
         if self.photo_image is None:  # frozen: the network's crop is the output crop
@@ -360,7 +362,7 @@ def located_input(photo: np.ndarray, size: int, name: str, backdrop: Backdrop = 
                        frame_coverage=round(found.frame_coverage, 4), neighbour_cut=found.neighbour_removed,
                        base_off_axis=round(found.base_off_axis, 4),
                        above_rim=(round(found.above_rim[0], 4), round(found.above_rim[1], 4)),
-                       painted_fill=round(found.painted_fill, 4))
+                       painted_fill=round(found.painted_fill, 4), greyscale=found.greyscale)
     return _on_backdrop(located, backdrop)
 
 
