@@ -313,7 +313,8 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
         grown = grow_sheen(refined.mask, refined.image, refined.outside)
         filled = fill_painted_holes(grown, greyscale)
         painted = float((filled & ~grown).sum() / filled.sum()) if greyscale else 0.0
-        refined, kept = replace(refined, mask=filled), filled & ~refined.mask
+        kept = filled & ~refined.mask  # given back on purpose: never taken out again as a gap
+        refined = replace(refined, mask=filled)
     mask, neighbour = cut_behind(refined.mask)
     if not neighbour:
         mask, neighbour = split_neighbour(mask)
