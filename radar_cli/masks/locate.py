@@ -250,11 +250,11 @@ def open_gaps(mask: np.ndarray, image: np.ndarray, outside: np.ndarray | None = 
     model, noise = fit_backdrop(pixels, ring)
     dist = np.sqrt((((pixels - model) / np.maximum(noise, GAP_LEVELS / GAP_DISTANCE)) ** 2).sum(axis=2))
     candidate = (mask & (dist < GAP_DISTANCE) & (True if kept is None else ~kept)).astype(np.uint8)
-    own = mask & (dist >= GAP_DISTANCE)  # the object's pixels unlike the backdrop
-    reach = max(1, round(GAP_AROUND * n))
     count, labels, stats, _ = cv2.connectedComponentsWithStats(candidate, connectivity=4)
     if count <= 1:
         return mask
+    own = mask & (dist >= GAP_DISTANCE)  # the object's pixels unlike the backdrop
+    reach = max(1, round(GAP_AROUND * n))
     depth = cv2.distanceTransform(np.pad(mask, 1).astype(np.uint8), cv2.DIST_L2, 3)[1:-1, 1:-1]
     tilt, axis = find_axis(mask)
     turn = upright_rotation(mask, tilt)

@@ -244,7 +244,7 @@ def judge(record: dict, limits: QualityLimits = QualityLimits()) -> tuple[str, l
         review.append("the photo's frame cuts off the object's top: its rim, and whatever stands on it, is not seen")
     elif limits.review_cut_sides and {"left", "right"} <= set(record.get("cut_edges", [])):
         review.append("the photo's frame cuts off both sides of the object: its full width is not seen")
-    review += neighbour_reasons(record, limits)
+    review += locating_reasons(record, limits)
     if failed:
         return "failed", failed + review
     return ("review", review) if review else ("ok", [])
@@ -296,7 +296,7 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
     return [words.format(record[key]) for key, bad, words in checks if record.get(key) is not None and bad(record[key])]
 
 
-def neighbour_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> list[str]:
+def locating_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> list[str]:
     """Review reasons about what the locator had to decide: a neighbouring object was cut away from the located
     object (the cut may run through the vessel), or one was probably kept with it; painting as grey as the
     backdrop was taken for the vessel, or a greyscale photo's outline may follow such painting."""
