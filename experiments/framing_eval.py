@@ -5,9 +5,10 @@
 Sources: the real photographs of ../shared/data/real_vases (when present; the reference silhouette is the one
 located on the original photo) and rendered vases pasted over studio backdrops (the truth is known). Each is
 turned into every `variants.KINDS` framing; the located silhouette (core and appendages) is compared with the
-reference cut by the same crop. Pasted vases also get handles: their located core is compared with the
-handle-free truth. Every variant is then de-rendered as `radar derender` does (output side 512, `--refine`,
-full by default) and its `quality` status is set against its silhouette IoU.
+reference in the located crop, the reference's parts outside the crop counted as missed. Pasted vases also get
+handles: their located core is compared with the handle-free truth. Every variant is then de-rendered as
+`radar derender` does (output side 512, `--refine`, full by default) and its `quality` status is set against
+its silhouette IoU.
 """
 
 from __future__ import annotations
@@ -34,7 +35,6 @@ from radar_cli.errors import InputError
 from radar_cli.fileio import read_image, write_image
 from radar_cli.masks import crop as crops
 from radar_cli.masks.locate import locate_object
-from radar_cli.masks.refine import iou
 from radar_cli.masks.synthetic import composite, render_vases
 from radar_cli.masks.variants import KINDS, Variant, make_variant, with_handles
 
@@ -92,8 +92,8 @@ def located_iou(variant: Variant) -> tuple[float, float]:
         found = locate_object(variant.image, EVAL_SIZE)
     except InputError:
         return 0.0, 0.0
-    truth = crops.cut(variant.truth.astype(np.float32), found.box, EVAL_SIZE, fill=0) > 0.5
-    return iou(found.silhouette | found.appendages, truth), iou(found.silhouette, truth)
+    return (crops.reference_iou(found.silhouette | found.appendages, variant.truth, found.box),
+            crops.reference_iou(found.silhouette, variant.truth, found.box))
 
 
 def evaluate(sources: list[tuple[str, np.ndarray, np.ndarray]], seed: int, synthetic: set[str],
@@ -144,8 +144,7 @@ def spoilt_input(kind: str, variant: Variant, size: int):
             prepared, silhouette=moved, image=white_backdrop(prepared.image, moved),
             photo_silhouette=photo_moved, photo_image=white_backdrop(prepared.photo_scene, photo_moved),
             backdrop="white")
-    truth = crops.cut(variant.truth.astype(np.float32), prepared.crop, size, fill=0) > 0.5
-    return prepared, iou(prepared.silhouette, truth)
+    return prepared, crops.reference_iou(prepared.silhouette, variant.truth, prepared.crop)
 
 
 def add_spoilt(results: Results, items: list[tuple[str, Variant]], size: int) -> dict:

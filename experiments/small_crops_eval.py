@@ -5,9 +5,9 @@ the located silhouette against the reference.
     python -m experiments.small_crops_eval data/small_crops --results RESULTS   # a `radar derender` run's folder
 
 The located object is the core and the appendages together (the vessel's whole outline, like the reference);
-the reference is cut by the located crop (IoU in that crop at 256 px). With --results, the silhouette.png and
-appendages.png that `radar derender data/small_crops/images --out RESULTS` wrote are read instead, mapped with
-the crop_box of material.json.
+the IoU is read in the located crop at 256 px, the reference's parts outside the crop counted as missed. With
+--results, the silhouette.png and appendages.png that `radar derender data/small_crops/images --out RESULTS`
+wrote are read instead, mapped with the crop_box of material.json.
 """
 
 from __future__ import annotations
@@ -25,7 +25,6 @@ from radar_cli.errors import InputError
 from radar_cli.fileio import read_image, write_image
 from radar_cli.masks import crop as crops
 from radar_cli.masks.locate import locate_object
-from radar_cli.masks.refine import iou
 
 EVAL_SIZE = 256
 PASS_IOU = 0.9
@@ -66,8 +65,7 @@ def measure(cases: Path, results: Path | None) -> list[dict]:
             seconds = time.process_time() - t0
             score = 0.0
             if found is not None:
-                truth = crops.cut(reference.astype(np.float32), found[0], EVAL_SIZE, fill=0) > 0.5
-                score = iou(found[1], truth)
+                score = crops.reference_iou(found[1], reference, found[0])
             rows.append({**case, "iou": score, "seconds": seconds, "found": found, "image": image,
                          "reference": reference})
     return rows

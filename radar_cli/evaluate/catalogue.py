@@ -20,8 +20,7 @@ import numpy as np
 from radar_cli.errors import InputError
 from radar_cli.evaluate import profiles as P
 from radar_cli.fileio import read_image, read_json
-from radar_cli.masks.crop import CropBox, cut
-from radar_cli.masks.refine import iou
+from radar_cli.masks.crop import CropBox, reference_iou
 from radar_cli.results import MASK_FILE, list_results
 from radar_cli.sizes import ObjectSize, read_size_table
 
@@ -59,7 +58,8 @@ class CatalogueReport:
 
 
 def _reference_iou(folder: Path, material: dict, silhouettes: Path, object_id: str, view: str) -> float | None:
-    """IoU of the drawn silhouette with the reference one cut by the result's crop box (None: no reference)."""
+    """IoU of the drawn silhouette with the reference one in the result's crop box, the reference's parts outside
+    the crop counted as missed (None: no reference)."""
     names = [folder.name] + ([f"{object_id}_{view}"] if view else [])
     found = [silhouettes / f"{n}.png" for n in names if (silhouettes / f"{n}.png").is_file()]
     if not found:
@@ -69,8 +69,7 @@ def _reference_iou(folder: Path, material: dict, silhouettes: Path, object_id: s
     box = material.get("crop_box")
     if not (isinstance(box, list) and len(box) == 3):
         raise ValueError("material.json has no crop_box to place the reference silhouette")
-    window = cut(reference.astype(np.float32), CropBox(*(int(v) for v in box)), drawn.shape[0], fill=0.0)
-    return iou(drawn, window > 0.5)
+    return reference_iou(drawn, reference, CropBox(*(int(v) for v in box)))
 
 
 def measure(folder: Path, object_id: str, view: str, size: ObjectSize, drawings: Path | None,

@@ -62,6 +62,24 @@ def cut(image: np.ndarray, crop: CropBox, size: int, fill: float | None = None) 
     return cv2.resize(window, (size, size), interpolation=interp)
 
 
+def reference_iou(located: np.ndarray, reference: np.ndarray, crop: CropBox) -> float:
+    """IoU of an object located in a crop with a reference silhouette drawn on the whole photo, in the crop's
+    pixels. The reference's pixels that the crop leaves out count as missed: a crop round part of the object
+    scores that part as lost, not just the part it shows.
+
+    Args:
+        located: S x S bool, the located object in the crop. reference: H x W bool, the object in the photo.
+        crop: the crop's window of the photo.
+    """
+    size = located.shape[0]
+    h, w = reference.shape
+    truth = cut(reference.astype(np.float32), crop, size, fill=0) > 0.5
+    shown = reference[max(0, crop.y0) : min(h, crop.y0 + crop.side), max(0, crop.x0) : min(w, crop.x0 + crop.side)]
+    missed = float(reference.sum() - shown.sum()) * (size / crop.side) ** 2
+    union = float(np.logical_or(located, truth).sum()) + missed
+    return float(np.logical_and(located, truth).sum()) / union if union else 1.0
+
+
 def outside_mask(crop: CropBox, image_shape: tuple[int, ...], size: int) -> np.ndarray:
     """size x size bool: True on the crop's padding (beyond the photo's edge), False on real photo pixels."""
     u0, v0, u1, v1 = valid_region(crop, image_shape, size)

@@ -31,7 +31,7 @@ def _crop_iou(photo: np.ndarray, truth: np.ndarray) -> float:
     found = process_image(photo, Settings())
     assert found, "nothing detected"
     best = max(found, key=lambda c: int(c.mask.sum()))
-    return iou(best.mask, crops.cut(truth.astype(np.float32), best.box, 256) > 0.5)
+    return crops.reference_iou(best.mask, truth, best.box)
 
 @pytest.mark.parametrize("kind,floor", [("plain", 0.95), ("gradient", 0.95), ("textured", 0.85),
                                         ("label", 0.93)])
@@ -51,6 +51,18 @@ def test_crop_geometry_object_fills_085():
     assert iou(out, warped) > 0.97
     ys = np.nonzero(out.any(1))[0]
     assert abs((ys.max() - ys.min() + 1) / 128 - 0.85) < 0.02
+
+def test_reference_iou_counts_what_the_crop_leaves_out():
+    reference = np.zeros((400, 400), bool)
+    reference[100:300, 150:250] = True
+    whole = crops.square_box(crops.mask_box(reference))
+    found = crops.cut(reference.astype(np.float32), whole, 128) > 0.5
+    assert crops.reference_iou(found, reference, whole) == pytest.approx(1.0)
+    lower = crops.CropBox(100, 200, 200)  # a crop round the lower half, the object's lower half located in it
+    found = crops.cut(reference.astype(np.float32), lower, 128) > 0.5
+    assert iou(found, crops.cut(reference.astype(np.float32), lower, 128, fill=0) > 0.5) == pytest.approx(1.0)
+    assert crops.reference_iou(found, reference, lower) == pytest.approx(0.5, abs=0.01)
+
 
 def test_crop_pads_outside_the_photo():
     img = np.full((50, 50, 3), 7, np.uint8)

@@ -10,7 +10,6 @@ import pytest
 
 from radar_cli.masks import crop as crops
 from radar_cli.masks.locate import locate_object
-from radar_cli.masks.refine import iou
 
 SIZE = 128
 
@@ -55,8 +54,7 @@ def to_photo(canvas: np.ndarray, quality: int = 85) -> np.ndarray:
 
 def located_iou(photo: np.ndarray, truth: np.ndarray) -> float:
     found = locate_object(photo, SIZE)
-    reference = crops.cut(truth.astype(np.float32), found.box, SIZE, fill=0) > 0.5
-    return iou(found.silhouette | found.appendages, reference)
+    return crops.reference_iou(found.silhouette | found.appendages, truth, found.box)
 
 
 def test_touching_three_edges_on_a_close_grey_sweep() -> None:
