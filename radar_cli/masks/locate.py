@@ -40,8 +40,8 @@ CUTOUT_MIN_CLEAR = 0.01  # an alpha channel with at least this share of clear pi
 STAND_MIN, STAND_MAX = 0.03, 0.6  # a stand's height as a fraction of the located height
 STAND_STEP = 0.08  # ... whose width differs from the vessel's foot above it by at least this fraction
 STAND_TOLERANCE = 0.015  # straight sides: the stand's edges move less than this fraction of the window per row
-STAND_COLOUR_STEP = 30.0  # ... and whose mean colour is this far (RGB levels) from the vessel's above it ...
-STAND_BIG_STEP = 0.25  # ... unless the width step is this large
+STAND_COLOUR_STEP = 75.0  # ... and whose mean colour is this far (RGB levels) from the vessel's above it ...
+STAND_BIG_STEP = 0.25  # ... unless it is wider than the foot by this share of its own width
 GAP_RING = (0.02, 0.06)  # the backdrop around the object is modelled from this ring (fraction of the window)
 GAP_DISTANCE = 3.0  # object pixels this close to the backdrop model (in its noise units) may be backdrop ...
 GAP_LEVELS = 20.0  # ... or this close in RGB levels, Euclidean (a gap seen through the vessel is lit otherwise) ...
@@ -131,8 +131,10 @@ def alpha_refined(rgb: np.ndarray, opaque: np.ndarray, found: Detection, setting
 def remove_stand(mask: np.ndarray, image: np.ndarray) -> tuple[np.ndarray, bool]:
     """Cut a stand off the bottom of a located object: the bottom rows with straight sides, a few percent to
     under two thirds of the object's height, clearly wider or narrower than the vessel's foot above them and of
-    another colour unless the step is large (a vessel's own foot ring is of its glaze; a straight vessel cut by
-    the frame has no step).
+    another colour (a white card, a grey or wooden plinth: STAND_COLOUR_STEP), unless much wider than the foot (a
+    plinth of the vessel's own colour). A vessel's own foot, ring or base is of its clay, glaze or glass, a few
+    tens of levels from what is above it even where a reserved band or thicker glass darkens or lightens it;
+    a straight vessel cut by the frame has no step.
 
     Args:
         mask: n x n bool located object. image: n x n x 3 uint8, the pixels it was located in.
@@ -162,8 +164,8 @@ def remove_stand(mask: np.ndarray, image: np.ndarray) -> tuple[np.ndarray, bool]
     above[: rows[max(0, k - span)]] = False
     above[rows[k]:] = False
     colour_step = np.linalg.norm(image[stand].mean(0) - image[above].mean(0))
-    step = abs(foot_w - stand_w) / stand_w
-    if step < STAND_STEP or (colour_step < STAND_COLOUR_STEP and step < STAND_BIG_STEP):
+    step = (foot_w - stand_w) / stand_w  # < 0: the stand is the wider
+    if abs(step) < STAND_STEP or (colour_step < STAND_COLOUR_STEP and step > -STAND_BIG_STEP):
         return mask, False
     return main_component(mask & ~stand), True
 

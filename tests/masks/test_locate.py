@@ -67,9 +67,16 @@ def test_stand_is_cut_off() -> None:
     cut, removed = remove_stand(mask, image)
     assert removed and not cut[80:].any() and cut[40].sum() == mask[40].sum() and cut[70].any()
     assert not remove_stand(mask, np.full_like(image, 60))[1]  # the vessel's own colour and a small step: kept
+    band = np.full_like(image, 60)
+    band[76:] = 95  # a foot ring of a lighter clay or glaze band: another shade, but the vessel's own
+    assert not remove_stand(mask, band)[1]
     wide = mask.copy()
     wide[76:, 20:80] = True  # a much wider plinth goes whatever its colour
     assert remove_stand(wide, np.full_like(image, 60))[1]
+    narrow = mask.copy()
+    narrow[76:] = False
+    narrow[76:, 42:58] = True  # a base much narrower than the foot above it, of the vessel's colour: its own
+    assert not remove_stand(narrow, np.full_like(image, 60))[1]
     cylinder = np.zeros_like(mask)
     cylinder[20:, 35:65] = True  # a straight-sided vessel cut by the frame is not a stand
     assert not remove_stand(cylinder, image)[1]
