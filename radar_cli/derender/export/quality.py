@@ -106,11 +106,11 @@ class QualityLimits:
     """More than this share of the located object's lowest rows off its symmetric core (`base_off_axis`):
     review (a neighbouring object, or a card in front of the foot, probably kept with it)."""
     review_painted_fill: float = PAINT_AREA
+    """On a greyscale photo, at least this share of the object filled in as paint of the backdrop's grey
+    (`painted_fill`): review (where the painting is as grey as the backdrop, the outline is a guess)."""
     review_greyscale_symmetry: float = 0.85
     """On a greyscale photo, the located object less symmetric about an axis than this (`object_symmetry`):
     review (read from brightness alone, its outline may follow painting as grey as the backdrop)."""
-    """On a greyscale photo, at least this share of the object filled in as paint of the backdrop's grey
-    (`painted_fill`): review (where the painting is as grey as the backdrop, the outline is a guess)."""
     review_above_rim: float = 0.08
     """More of the object than this (its area over the core's) standing above its rim over the mouth, left out of
     the solid (`above_rim`): review (a lid's head, a stopper, a figure or flowers)."""
