@@ -24,6 +24,8 @@ import numpy as np
 BORDER_FRAC = 0.04  # width of the border band the backdrop is fitted to, as a fraction of the long edge
 STEP_SPAN = 2  # a step is the colour change over 2 x this many pixels along the ring ...
 STEP_EDGE = 20.0  # ... and an outline crossing the band where it exceeds this (RGB levels, Euclidean)
+SOFT_SPAN = 6  # a soft outline (a blurred, low-contrast scan) is a change over 2 x this many pixels ...
+SOFT_EDGE = 30.0  # ... over this (a backdrop's shading changes a few levels over such a span)
 RING_PIECES = 32  # runs are judged in pieces of at most 1 / this of the ring (a long run spans a gradient) ...
 RUN_TOLERANCE = 14.0  # ... pieces whose median colours a gradient explains this closely (levels) show it
 GRADIENT_TRIES = 400  # random triples of pieces a gradient is fitted through
@@ -95,9 +97,16 @@ def _ends(profile: np.ndarray, start: int, stop: int) -> tuple[np.ndarray, np.nd
     return np.median(profile[head], axis=0), np.median(profile[tail], axis=0)
 
 
+def _steps(profile: np.ndarray, span: int, edge: float) -> np.ndarray:
+    """Ring positions (int) where the colour changes by over `edge` across 2 x `span` pixels, most there."""
+    step = np.linalg.norm(np.roll(profile, -span, 0) - np.roll(profile, span, 0), axis=1)
+    return np.nonzero((step > edge) & (step >= np.roll(step, 1)) & (step >= np.roll(step, -1)))[0]
+
+
 def ring_runs(image: np.ndarray, band: np.ndarray) -> list[Run]:
-    """The band cut at the sharp colour steps along the ring (STEP_EDGE over 2 x STEP_SPAN pixels), in ring
-    order; one run if the ring has fewer than two steps."""
+    """The band cut at the colour steps along the ring, in ring order (one run if the ring has fewer than two):
+    sharp ones (STEP_EDGE over 2 x STEP_SPAN pixels) and, along the top and bottom edges, soft ones (SOFT_EDGE
+    over 2 x SOFT_SPAN) with no sharp one near."""
     flat, position, lengths, c = _ring(band.shape, band)
     profile = _profile(image, c, lengths)
     n = len(profile)
@@ -105,8 +114,15 @@ def ring_runs(image: np.ndarray, band: np.ndarray) -> list[Run]:
     whole = Run(flat, position, n, *_ends(profile, 0, n), np.median(values[flat], axis=0))
     if n < 4 * STEP_SPAN + 2:
         return [whole]
-    step = np.linalg.norm(np.roll(profile, -STEP_SPAN, 0) - np.roll(profile, STEP_SPAN, 0), axis=1)
-    cuts = np.nonzero((step > STEP_EDGE) & (step >= np.roll(step, 1)) & (step >= np.roll(step, -1)))[0]
+    cuts = _steps(profile, STEP_SPAN, STEP_EDGE)
+    soft = _steps(profile, SOFT_SPAN, SOFT_EDGE)  # where no sharp step is near: a soft outline; only along the
+    # top and bottom edges, which an upright vessel's rim and foot cross (a sweep's horizon, a table's edge and
+    # the shading between wall and floor cross the sides)
+    top, bottom = (soft < lengths[0]), (soft >= lengths[0] + lengths[1]) & (soft < n - lengths[3])
+    soft = soft[top | bottom]
+    if len(soft):
+        gap = np.abs((soft[:, None] - cuts[None] + n // 2) % n - n // 2).min(1) if len(cuts) else n + 0 * soft
+        cuts = np.sort(np.concatenate([cuts, soft[gap > SOFT_SPAN]]))
     if len(cuts) < 2:
         return [whole]
     run = np.searchsorted(cuts, position, side="right") % len(cuts)  # past the last cut: back to the first run
@@ -229,9 +245,12 @@ def backdrop_band(image: np.ndarray) -> np.ndarray:
         return band
     weight = np.array([len(r.pixels) for r in runs], np.float64)
     colours = np.array([r.median for r in runs])  # R x 3
-    long = weight >= LONG_SHARE * weight[chosen].max()  # whole sides of the frame, lit differently, if near
-    # the colour of a long backdrop run (not of a fragment between two steps that the gradient happens to explain)
-    near = (np.linalg.norm(colours[:, None] - colours[chosen & long][None], axis=2) < LONG_TOLERANCE).any(1)
+    # whole sides of the frame, lit differently, if near the colour of a main backdrop run (not of a fragment
+    # between two steps that the gradient happens to explain); long as against all the backdrop seen, so that
+    # a backdrop cut in two by a foot on the bottom edge does not make a rim cut by the top edge long
+    main = chosen & (weight >= LONG_SHARE * weight[chosen].max())
+    near = (np.linalg.norm(colours[:, None] - colours[main][None], axis=2) < LONG_TOLERANCE).any(1)
+    long = weight >= LONG_SHARE * weight[chosen].sum()
     chosen = _bridged(runs, chosen | (long & near))
     out = np.zeros(h * w, bool)
     for r, keep in zip(runs, chosen):

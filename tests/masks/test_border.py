@@ -1,14 +1,17 @@
 """Which parts of the border show the backdrop: a vignette or sweep however steep is all backdrop, an object
-running into the frame is not (a dark rim cut by the top edge above a lit floor neither), a label standing in the
-band does not cut the backdrop beyond it off, and a flat frame round the picture is found. The pictures are drawn
-here."""
+running into the frame is not (a dark rim cut by the top edge above a lit floor neither, nor the soft rim and
+foot of a greyscale catalogue plate), a label standing in the band does not cut the backdrop beyond it off, and a
+flat frame round the picture is found. The pictures are drawn here."""
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 
+from radar_cli.masks import crop as crops
 from radar_cli.masks.border import PAD_SMEAR, backdrop_band, border_band, frame_inset, frame_padding
+from radar_cli.masks.locate import locate_object
 from radar_cli.masks.neighbours import base_off_axis
 
 H, W = 300, 240
@@ -84,6 +87,29 @@ def test_a_rim_cut_by_the_top_edge_is_not_taken_for_the_backdrop(floor: float, p
     band, kept = border_band(photo.shape[:2]), backdrop_band(photo)
     assert kept[band & vessel].mean() < 0.05
     assert kept[band & ~vessel].mean() > 0.97
+
+
+def grey_plate(ground: float = 0.62, vessel: float = 0.5, sigma: float = 5.0) -> tuple[np.ndarray, np.ndarray]:
+    """(H x W x 3 uint8 photo, H x W bool vessel): an older catalogue's greyscale plate, the vessel cut by the top
+    edge at its wide rim and by the bottom edge at its foot, 30 levels darker than the ground and soft (no step
+    along the border is sharper than 17 levels over 4 px)."""
+    vessel_mask = ellipse(120, 150, 100, 120)
+    vessel_mask[:28, 22 : W - 22] = True  # the rim, over four fifths of the top edge
+    vessel_mask[H - 22 :, 78:162] = True  # the foot
+    grey = cv2.GaussianBlur(np.where(vessel_mask, vessel, ground), (0, 0), sigma)
+    return to_uint8(np.repeat(grey[..., None], 3, axis=2)), vessel_mask
+
+
+def test_the_soft_rim_and_foot_of_a_grey_plate_are_not_backdrop() -> None:
+    """The rim's run is long and within LONG_TOLERANCE of the ground, and the foot parts the ground's run in two:
+    read by sharp steps alone, or with "long" measured against the longest backdrop run, the whole band was
+    backdrop and the backdrop model went dark at the top. The vessel is then located whole."""
+    photo, vessel = grey_plate()
+    band, kept = border_band(photo.shape[:2]), backdrop_band(photo)
+    assert kept[band & vessel].mean() < 0.05
+    assert kept[band & ~vessel].mean() > 0.97
+    found = locate_object(photo, 128)  # whole: 0.82 when the rim was backdrop and the upper body went with it
+    assert crops.reference_iou(found.silhouette | found.appendages, vessel, found.box) >= 0.9
 
 
 def test_a_flat_frame_round_the_picture_is_found_and_a_plain_backdrop_is_not() -> None:
