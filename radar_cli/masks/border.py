@@ -2,13 +2,14 @@
 
 The border band is read along the ring it makes around the photo. An object that runs into the frame crosses
 the band with its outline: a sharp colour step along the ring. Shading of the backdrop (a sweep, a vignette,
-a light pool) changes its colour slowly, however much in all. The ring is cut at the sharp steps into runs;
-with none, or only one, the whole band is backdrop. Otherwise the backdrop is the set of runs, each at least
-half explained by one linear colour gradient across the frame (a flat backdrop or a sweep), that holds the most
-explained pixels; of two neighbouring runs of clearly different colours at most one is in it (the step between
-them is the object's outline). It is grown by long runs of a somewhat different colour (a whole side of the frame
-lit differently) and by the runs that continue a backdrop run's colour across a short interruption (a label, a
-chart, a scale bar).
+a light pool) changes its colour slowly, however much in all. The ring is cut at the sharp steps into runs (and,
+along the top and bottom edges, which an upright vessel's rim and foot cross, at soft ones: a blurred,
+low-contrast plate); with none, or only one, the whole band is backdrop. Otherwise the backdrop is the set of
+runs, each at least half explained by one linear colour gradient across the frame (a flat backdrop or a sweep),
+that holds the most explained pixels; of two neighbouring runs of clearly different colours at most one is in it
+(the step between them is the object's outline). It is grown by long runs (against all the backdrop runs
+together) of a somewhat different colour (a whole side of the frame lit differently) and by the runs that
+continue a backdrop run's colour across a short interruption (a label, a chart, a scale bar).
 
 A flat frame round the picture (a black or white border that squared the photo up) is neither backdrop nor
 object (`frame_padding`).
@@ -121,7 +122,9 @@ def ring_runs(image: np.ndarray, band: np.ndarray) -> list[Run]:
     top, bottom = (soft < lengths[0]), (soft >= lengths[0] + lengths[1]) & (soft < n - lengths[3])
     soft = soft[top | bottom]
     if len(soft):
-        gap = np.abs((soft[:, None] - cuts[None] + n // 2) % n - n // 2).min(1) if len(cuts) else n + 0 * soft
+        gap = np.full(len(soft), n)  # along the ring to the nearest sharp step
+        if len(cuts):
+            gap = np.abs((soft[:, None] - cuts[None] + n // 2) % n - n // 2).min(1)
         cuts = np.sort(np.concatenate([cuts, soft[gap > SOFT_SPAN]]))
     if len(cuts) < 2:
         return [whole]
