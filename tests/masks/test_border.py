@@ -102,8 +102,8 @@ def grey_plate(ground: float = 0.62, vessel: float = 0.5, sigma: float = 5.0) ->
 
 def test_the_soft_rim_and_foot_of_a_grey_plate_are_not_backdrop() -> None:
     """The rim's run is long and within LONG_TOLERANCE of the ground, and the foot parts the ground's run in two:
-    read by sharp steps alone, or with "long" measured against the longest backdrop run, the whole band was
-    backdrop and the backdrop model went dark at the top. The vessel is then located whole."""
+    read by sharp steps alone, the whole band was backdrop (with "long" measured against the longest backdrop
+    run, 70 % of the rim and foot) and the backdrop model went dark at the top. The vessel is then located whole."""
     photo, vessel = grey_plate()
     band, kept = border_band(photo.shape[:2]), backdrop_band(photo)
     assert kept[band & vessel].mean() < 0.05
