@@ -32,6 +32,7 @@ CUT_GAIN = 0.02  # every cut here must raise the solid-of-revolution score (`qua
 BASE = 0.4  # `base_off_axis` reads this lowest share of the object's rows
 BASE_MERGED = 0.1  # more of those rows than this off the symmetric core: something probably merged at the base
 BASE_CUT_MAX = 0.25  # `cut_base` cuts at most this share of the object
+BASE_PART_TOP = 0.5  # `cut_base` cuts only parts starting this share of the object's height below its top, or lower
 
 
 def rounder(cut: np.ndarray, whole: np.ndarray) -> bool:
@@ -113,7 +114,10 @@ def cut_base(whole: np.ndarray, core: np.ndarray) -> tuple[np.ndarray, bool]:
     than BASE_MERGED lie off its symmetric core (`base_off_axis`), the connected parts off the core that reach
     into those rows (a card or label in front of the foot, a neighbour beside it) are cut, if they are a small
     part of the object (BASE_CUT_MAX) and the vessel left is more of a solid of revolution (CUT_GAIN). A
-    vessel's own foot is symmetric and its handles sit higher.
+    vessel's own foot is symmetric and its handles sit higher. A part that rises into the object's upper half
+    (BASE_PART_TOP) stays: what stands before the foot rises from the floor, while a strip down the vessel's
+    own flank is off the core where the core came out narrow (a flank or handle lost on the other side, on a
+    low-contrast greyscale plate) or the outline is uneven.
 
     Args:
         whole: n x n bool located object; core: n x n bool, its symmetric core (inside `whole`).
@@ -123,11 +127,13 @@ def cut_base(whole: np.ndarray, core: np.ndarray) -> tuple[np.ndarray, bool]:
     start = _base_start(whole)
     if start is None or base_off_axis(whole, core) <= BASE_MERGED:
         return whole, False
-    _, labels = cv2.connectedComponents((whole & ~core).astype(np.uint8), connectivity=8)
+    _, labels, stats, _ = cv2.connectedComponentsWithStats((whole & ~core).astype(np.uint8), connectivity=8)
+    rows = np.nonzero(whole.any(1))[0]
+    highest = rows[0] + BASE_PART_TOP * (rows[-1] - rows[0] + 1)  # the highest row a part cut may start at
     low = np.unique(labels[start:])
-    parts = np.isin(labels, low[low > 0])
+    parts = np.isin(labels, low[(low > 0) & (stats[low, cv2.CC_STAT_TOP] >= highest)])
     cut = whole & ~parts
-    if parts.sum() > BASE_CUT_MAX * whole.sum() or not rounder(cut, whole):
+    if not parts.any() or parts.sum() > BASE_CUT_MAX * whole.sum() or not rounder(cut, whole):
         return whole, False
     return cut, True
 

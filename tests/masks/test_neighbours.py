@@ -2,8 +2,8 @@
 vessel, a one-handled jug, a tilted vessel and a neighbour standing level beside it are left to the rest of the
 locator; one standing beside it is split off at the valley, but not the halves of a vessel that its painting
 carved; one cut by the photo's side edge is cut off where it meets the frame, but not a vessel that the frame
-itself cuts. A card in front of the foot is cut off the located object; a vessel's own handles are not. The
-photos and masks are drawn here."""
+itself cuts. A card in front of the foot is cut off the located object; a vessel's own handles are not, nor a
+strip down its flank that rises into its upper half. The photos and masks are drawn here."""
 
 from __future__ import annotations
 
@@ -113,3 +113,16 @@ def test_a_card_in_front_of_the_foot_is_cut_off_and_handles_stay() -> None:
     handles = main | ((ring <= 1) & (ring >= 0.45) & (x > 140))
     kept, removed = cut_base(handles, main)
     assert not removed and (kept == handles).all()
+
+
+def test_a_strip_down_the_flank_stays_when_a_card_before_the_foot_is_cut() -> None:
+    """Off a narrow core (the other flank lost on a low-contrast plate) a strip of the vessel's own flank reaches the
+    base rows; it rises into the upper half, which nothing standing before the foot does."""
+    main = vessel(100, 20, 200, 120)
+    y, x = np.mgrid[0:H, 0:W]
+    card = (x >= 110) & (x < 200) & (y >= 175) & (y < 215)
+    wider = cv2.dilate(main.astype(np.uint8), np.ones((1, 9), np.uint8)) > 0
+    strip = wider & ~main & (x < 100) & (y >= 70)  # 4 px down the left flank, from the upper body to the foot
+    cut, removed = cut_base(main | card | strip, main)
+    assert removed and not (cut & card & ~main).any()
+    assert (cut & strip).sum() == strip.sum()
