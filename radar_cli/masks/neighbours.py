@@ -54,8 +54,9 @@ def _valley(profile: np.ndarray, start: int, step: int) -> int | None:
 
 
 def split_neighbour(mask: np.ndarray) -> tuple[np.ndarray, bool]:
-    """The main vessel of a located n x n bool mask with a merged neighbour cut off at the valley between them,
-    if the vessel kept is the more symmetric for it (a light figure painted on a low-contrast body can carve a
+    """The main vessel of a located n x n bool mask with a merged neighbour cut off at the valley between them
+    (of the parts between and beyond the valleys, the one with the most pixels is kept), if the vessel kept is the
+    more symmetric for it (a light figure painted on a low-contrast body can carve a
     valley into the vessel itself; its half alone is far less a solid of revolution than the whole).
 
     Returns:
@@ -68,7 +69,7 @@ def split_neighbour(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     lower[: rows.min() + int((1 - LOWER) * (rows.max() - rows.min() + 1))] = False
     profile = cv2.GaussianBlur(lower.sum(0).astype(np.float32)[None], (0, 0), max(1.0, mask.shape[1] / 100))[0]
     start = int(np.argmax(profile))
-    out, cut = mask.copy(), False
+    middle, parts = mask.copy(), []
     for step in (-1, 1):
         at = _valley(profile, start, step)
         if at is None:
@@ -79,11 +80,12 @@ def split_neighbour(mask: np.ndarray) -> tuple[np.ndarray, bool]:
         else:
             beyond[:, at:] = True
         if (mask & beyond).sum() >= MIN_PART * mask.sum():
-            out &= ~beyond
-            cut = True
-    if not cut:
+            middle &= ~beyond
+            parts.append(mask & beyond)
+    if not parts:
         return mask, False
-    kept = main_component(out)
+    # the hump the profile peaks in may be a taller but narrower neighbour (an albarello beside a krater)
+    kept = main_component(max([middle, *parts], key=lambda part: int(part.sum())))
     return (kept, True) if rounder(kept, mask) else (mask, False)
 
 

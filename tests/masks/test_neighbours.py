@@ -1,9 +1,10 @@
-"""A second vessel standing behind the located one (partly hidden by it, standing higher) is cut off; a lone
-vessel, a one-handled jug, a tilted vessel and a neighbour standing level beside it are left to the rest of the
-locator; one standing beside it is split off at the valley, but not the halves of a vessel that its painting
-carved; one cut by the photo's side edge is cut off where it meets the frame, but not a vessel that the frame
-itself cuts. A card in front of the foot is cut off the located object; a vessel's own handles are not, nor a
-strip down its flank that rises into its upper half. The photos and masks are drawn here."""
+"""A second vessel standing behind the located one (partly hidden by it, standing higher) is cut off; a lone vessel, a
+one-handled jug, a tilted vessel and a neighbour standing level beside it are left to the rest of the locator; one
+standing beside it is split off at the valley (the larger part kept, though a taller neighbour's columns peak
+higher), but not the halves of a vessel that its painting carved; one cut by the photo's side edge is cut off where
+it meets the frame, but not a vessel that the frame itself cuts. A card in front of the foot is cut off the located
+object; a vessel's own handles are not, nor a strip down its flank that rises into its upper half. The photos and
+masks are drawn here."""
 
 from __future__ import annotations
 
@@ -64,6 +65,17 @@ def test_a_neighbour_beside_is_split_off_and_a_vessel_carved_by_its_painting_is_
     carved[:160, 104:116] = False  # the figure, as light as the backdrop, open to the mouth
     kept, split = split_neighbour(carved)
     assert not split and (kept == carved).all()
+
+
+def test_a_taller_narrower_neighbour_beside_is_the_one_split_off() -> None:
+    """The lower columns peak in a tall cylinder (an albarello) standing beside a wide krater; the krater, the
+    larger part, is kept."""
+    y, x = np.mgrid[0:H, 0:W]
+    main = vessel(130, 20, 200, 150)
+    tall = (np.abs(x - 28) <= 22) & (y >= 10) & (y <= 225)
+    bridge = (y >= 150) & (y <= 160) & (x >= 40) & (x <= 80)  # where the two touch in the photo
+    kept, split = split_neighbour(main | tall | bridge)
+    assert split and iou(kept, main) >= 0.95
 
 
 def test_a_neighbour_cut_by_the_frame_is_cut_off_and_a_vessel_cut_by_it_is_not() -> None:
