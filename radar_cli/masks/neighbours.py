@@ -56,8 +56,8 @@ def _valley(profile: np.ndarray, start: int, step: int) -> int | None:
 def split_neighbour(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     """The main vessel of a located n x n bool mask with a merged neighbour cut off at the valley between them
     (of the parts between and beyond the valleys, the one with the most pixels is kept), if the vessel kept is the
-    more symmetric for it (a light figure painted on a low-contrast body can carve a
-    valley into the vessel itself; its half alone is far less a solid of revolution than the whole).
+    more symmetric for it (a light figure painted on a low-contrast body can carve a valley into the vessel itself;
+    its half alone is far less a solid of revolution than the whole).
 
     Returns:
         (mask, whether a neighbour was cut off).
