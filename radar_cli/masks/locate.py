@@ -321,7 +321,7 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     if not neighbour:
         mask, neighbour = split_neighbour(mask)
     mask, stand = remove_stand(open_gaps(mask, refined.image, refined.outside, kept, greyscale), refined.image)
-    mask, _ = cut_on_rim(mask)  # flowers, stems
+    mask, _ = cut_on_rim(mask, greyscale)  # flowers, stems
     mask, framed = cut_at_frame(mask, refined.outside)  # after the stand: a plinth cut by the frame is no neighbour
     neighbour = neighbour or framed
     split: Core = symmetric_core(mask)

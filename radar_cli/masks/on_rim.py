@@ -8,10 +8,15 @@ the widest of the few rows up to it is the rim's top; the parts above it that co
 (within half the rim's half-width of the axis) are cut off where they are sparse (stems and blossoms, under
 SPARSE of their bounding box: a lid's knob or a head is compact), rise at least MIN_RISE of the object's height,
 are not symmetric about the axis, and the vessel left is more of a solid of revolution (`neighbours.CUT_GAIN`).
-Volutes and handles rising above the rim stand at its ends, not over the mouth, and stay. A narrow neck under a
-wide lip, found in part (a glass neck as grey as the backdrop), ends its shoulder as a rim would and is sparse in
-its box too, but it is its mirror image about the axis (IoU 0.59-0.75 on the small crops where it was cut), where
-stems and blossoms are not (at most 0.49)."""
+Volutes and handles rising above the rim stand at its ends, not over the mouth, and stay.
+
+A narrow neck under a wide lip, found in part (a glass neck as grey as the backdrop), ends its shoulder as a rim
+would and is sparse in its box too, but it is its own mirror image about the axis (IoU 0.59-0.75 on the small
+crops where it was cut), where stems and blossoms are not (at most 0.49): a part of SYMMETRIC or more stays. On
+a colour photo a denser part (up to DENSE of its box: a bunch whose blossoms and leaves the cut filled in between)
+is cut too where it is far from its own mirror image (under ASYMMETRIC; a lid's head or knob is its own mirror
+image). On a greyscale photo the vessel's own rim, where parts of it are as grey as the backdrop, can come out
+dense and lopsided above the rim's top found there, so only sparse parts are cut."""
 
 from __future__ import annotations
 
@@ -26,6 +31,8 @@ RIM_WINDOW = 0.01  # ... the widest run of this share of the object's height of 
 SPARSE = 0.5  # what stands on the rim fills under this share of its bounding box (stems, not a knob)
 MIN_RISE = 0.05  # ... and rises at least this share of the object's height above the rim
 SYMMETRIC = 0.55  # ... and its IoU with its mirror image about the axis is under this (a neck and lip are over it)
+DENSE = 0.75  # on a colour photo a denser part, up to this share of its box, is cut too ...
+ASYMMETRIC = 0.3  # ... where its IoU with its mirror image is under this
 
 
 def central_runs(mask: np.ndarray, axis: int) -> np.ndarray:
@@ -67,8 +74,9 @@ def mirror_iou(part: np.ndarray, axis: float) -> float:
     return float((part & mirrored).sum() / max(1, (part | mirrored).sum()))
 
 
-def cut_on_rim(mask: np.ndarray) -> tuple[np.ndarray, bool]:
-    """The located vessel (n x n bool) without what stands on its rim over the mouth (see the module).
+def cut_on_rim(mask: np.ndarray, greyscale: bool = False) -> tuple[np.ndarray, bool]:
+    """The located vessel (n x n bool) without what stands on its rim over the mouth (see the module); on a
+    greyscale photo (`greyscale`) only sparse parts are cut.
 
     Returns:
         (mask, whether anything was cut off).
@@ -94,7 +102,9 @@ def cut_on_rim(mask: np.ndarray) -> tuple[np.ndarray, bool]:
     part = np.isin(labels, over)
     ys, xs = np.nonzero(part)
     fill = part.sum() / ((ys.max() - ys.min() + 1) * (xs.max() - xs.min() + 1))
-    if fill >= SPARSE or rim - ys.min() < MIN_RISE * (bottom - top + 1) or mirror_iou(part, axis) >= SYMMETRIC:
+    symmetry = mirror_iou(part, axis)
+    sparse = fill < SPARSE or (not greyscale and fill < DENSE and symmetry < ASYMMETRIC)
+    if not sparse or rim - ys.min() < MIN_RISE * (bottom - top + 1) or symmetry >= SYMMETRIC:
         return mask, False
     cut = main_component(mask & ~part)
     return (cut, True) if rounder(cut, mask) else (mask, False)
