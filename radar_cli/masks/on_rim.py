@@ -24,6 +24,7 @@ import cv2
 import numpy as np
 
 from radar_cli.masks.neighbours import rounder
+from radar_cli.masks.quality import mirror_iou
 from radar_cli.masks.refine import main_component, row_extents
 
 RIM_STEP = 0.5  # the run above the rim's top row is under this share of the rim's run ...
@@ -62,16 +63,6 @@ def rim_top(rows: np.ndarray, runs: np.ndarray) -> int | None:
         if runs[y - 1] < RIM_STEP * runs[y : y + window].max():
             return y
     return None
-
-
-def mirror_iou(part: np.ndarray, axis: float) -> float:
-    """IoU of an n x n bool part with its mirror image about the column `axis`."""
-    cols = np.arange(part.shape[1])
-    source = np.round(2 * axis - cols).astype(int)
-    inside = (source >= 0) & (source < part.shape[1])
-    mirrored = np.zeros_like(part)
-    mirrored[:, inside] = part[:, source[inside]]
-    return float((part & mirrored).sum() / max(1, (part | mirrored).sum()))
 
 
 def cut_on_rim(mask: np.ndarray, greyscale: bool = False) -> tuple[np.ndarray, bool]:

@@ -91,6 +91,18 @@ def mirror_agreement(mask: np.ndarray) -> tuple[float, float]:
     return best, best_axis
 
 
+def mirror_iou(mask: np.ndarray, axis: float) -> float:
+    """IoU of an n x n bool mask with its mirror image about the given column `axis` (not searched, as
+    `mirror_agreement` does: whether a part is symmetric about the vessel's own axis); what the mirror image
+    throws past the frame counts as missing."""
+    cols = np.arange(mask.shape[1])
+    source = np.round(2 * axis - cols).astype(int)
+    inside = (source >= 0) & (source < mask.shape[1])
+    mirrored = np.zeros_like(mask)
+    mirrored[:, inside] = mask[:, source[inside]]
+    return float((mask & mirrored).sum() / max(1, (mask | mirrored).sum()))
+
+
 def profile_agreement(mask: np.ndarray, axis: float) -> float:
     """IoU of a bool mask with the solid it implies: each row filled symmetrically about `axis` out to the row's
     mean extent. Gaps within a row (handles) and lopsided rows lower it."""
