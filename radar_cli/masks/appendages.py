@@ -148,6 +148,12 @@ def _handle_plates(mask: np.ndarray, axis: float, left: np.ndarray, right: np.nd
     two handles' outer edges just under them (`PLATE_BELOW`): the plates the handles carry reach past the rim.
     Where the object stands above those rows on both sides (volutes), by the handles' inner edges instead.
 
+    A side stands apart from the core where its outermost pixel lies past what the core keeps there by more than
+    `SIDE_TOLERANCE` of the object's width (two plates a little unequal are no handle). The rows down to the
+    later of the two handles are the plates' on both sides, and both handles are read from there: a sliver of
+    backdrop under one plate, which a rescaled or mirrored photo may show or not, moves where one handle starts
+    by a few rows, and the handles' outer edges slope fast just under the plates.
+
     Args:
         mask: H x W bool upright silhouette. axis: its axis' x. left, right: H, the axis runs' half-widths
             (`_axis_runs`). limit: H, the per-row half-width bound. rows: the rows holding an axis run.
@@ -157,9 +163,11 @@ def _handle_plates(mask: np.ndarray, axis: float, left: np.ndarray, right: np.nd
     outer_l, outer_r = _outer_extents(mask, axis)
     window = np.arange(rows.min(), min(mask.shape[0], rows.min() + int(round(SPIKE_SPAN * height))))
     run = max(2, int(round(PLATE_BELOW[1] * height)))  # a handle: longer than a ragged or lopsided plate
+    cols = np.nonzero(mask.any(0))[0]
+    tol = SIDE_TOLERANCE * (cols.max() - cols.min() + 1)
     kept_l, kept_r = np.fmin(left, limit), np.fmin(right, limit)  # what the core keeps on each side so far
-    apart = np.stack([runs_of(outer_l[window] > kept_l[window] + 1.0, run),
-                      runs_of(outer_r[window] > kept_r[window] + 1.0, run)])  # 2 x n: beside a handle
+    apart = np.stack([runs_of(outer_l[window] > kept_l[window] + 1.0 + tol, run),
+                      runs_of(outer_r[window] > kept_r[window] + 1.0 + tol, run)])  # 2 x n: beside a handle
     joined = np.nonzero(~apart.any(0))[0]  # neither: the plates, the rim
     if len(joined) == 0:
         return out
@@ -167,13 +175,14 @@ def _handle_plates(mask: np.ndarray, axis: float, left: np.ndarray, right: np.nd
     below = [start + np.argmax(apart[s, start:]) if apart[s, start:].any() else -1 for s in (0, 1)]
     if min(below) <= start:
         return out
+    under = max(below)  # the later handle's first row
     xs = np.arange(mask.shape[1]) + 0.5 - (axis + 0.5)  # pixel centres relative to the axis
     above = mask[: rows.min()]
     volutes = min(int((above & (xs < 0)).any(1).sum()), int((above & (xs > 0)).any(1).sum())) >= END_ROWS * height
     edges = []
     for s, outer, kept in ((0, outer_l, kept_l), (1, outer_r, kept_r)):
-        a = window[below[s]] + int(round(PLATE_BELOW[0] * height))
-        b = window[below[s]] + max(1, int(round(PLATE_BELOW[1] * height)))
+        a = window[under] + int(round(PLATE_BELOW[0] * height))
+        b = window[under] + max(1, int(round(PLATE_BELOW[1] * height)))
         if volutes:  # the handle's first pixel past what the core keeps
             side = np.abs(xs) * (np.sign(xs) == (1 if s else -1))
             beyond = mask[a:b] & (side > kept[a:b, None] + 1.0)
@@ -184,7 +193,7 @@ def _handle_plates(mask: np.ndarray, axis: float, left: np.ndarray, right: np.nd
         if len(handle) == 0:
             return out
         edges.append(float(np.median(handle)))
-    band = window[start : min(below)]
+    band = window[start:under]
     out[band] = np.fmin(out[band], float(np.mean(edges)))
     return out
 
