@@ -1,0 +1,96 @@
+"""The CVA 10 side views as other photographers and sites would give them: how stable are the pitch, the ratios
+and the status when the same vessel is photographed at another size, mirrored, exposed darker, cropped closer or
+given more backdrop?
+
+    python -m experiments.photo_variants OUT [--shared ../shared] [--kind whole|fragment]
+
+writes OUT/<object>_<view>_<variant>.jpg for every object of that kind in `cva10/objects.tsv` and each of its
+views but the top view (the 5 whole kraters' 20 side views, or the 8 fragments' outsides and insides), in 7
+variants:
+
+- `orig`: the photograph as it is (a copy of the file; the others are written at JPEG quality 90);
+- `half`, `quarter`: scaled to 1/2 and 1/4 (about 850 and 430 px; the quarter is a web image's size);
+- `flip`: mirrored left to right (a solid of revolution's fit should not care);
+- `dark`: every channel raised to the power 1.4 (a darker exposure of the midtones);
+- `tight`: cut to 84 % of the width and 91 % of the height, so the handles or the foot may touch the frame;
+- `wide`: 15 % of the photo's size more backdrop on every side (the border pixels repeated).
+
+Then `radar derender OUT --out R --views 1` and `radar eval-catalog R --dimensions
+../shared/data/cva10/objects.tsv --drawings docs/data/cva10-profiles` (a result `73AE135_front_half` is matched
+to the object `73AE135`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import shutil
+from collections.abc import Callable
+from pathlib import Path
+
+import cv2
+import numpy as np
+from PIL import Image
+
+from radar_cli.fileio import read_image
+
+
+def _scaled(k: float) -> Callable[[np.ndarray], np.ndarray]:
+    def scale(image: np.ndarray) -> np.ndarray:
+        h, w = image.shape[:2]
+        return cv2.resize(image, (int(w * k), int(h * k)), interpolation=cv2.INTER_AREA)
+
+    return scale
+
+
+def _tight(image: np.ndarray) -> np.ndarray:
+    h, w = image.shape[:2]
+    return image[int(0.06 * h) : int(0.97 * h), int(0.08 * w) : int(0.92 * w)]
+
+
+def _wide(image: np.ndarray) -> np.ndarray:
+    h, w = image.shape[:2]
+    dy, dx = int(0.15 * h), int(0.15 * w)
+    return cv2.copyMakeBorder(image, dy, dy, dx, dx, cv2.BORDER_REPLICATE)
+
+
+def _dark(image: np.ndarray) -> np.ndarray:
+    return np.clip(255.0 * (image / 255.0) ** 1.4, 0, 255).astype(np.uint8)
+
+
+VARIANTS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
+    "half": _scaled(0.5),
+    "quarter": _scaled(0.25),
+    "flip": lambda image: image[:, ::-1],
+    "dark": _dark,
+    "tight": _tight,
+    "wide": _wide,
+}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out", type=Path)
+    parser.add_argument("--shared", type=Path, default=Path("../shared"))
+    parser.add_argument("--kind", choices=("whole", "fragment"), default="whole")
+    args = parser.parse_args()
+    cva = args.shared / "data" / "cva10"
+    with open(cva / "objects.tsv", newline="") as table:
+        rows = [row for row in csv.DictReader(table, delimiter="\t") if row["kind"] == args.kind]
+    args.out.mkdir(parents=True, exist_ok=True)
+    count = 0
+    for row in rows:
+        obj = row["object"]
+        for view in sorted(set(row["views"].split()) - {"top"}):
+            source = cva / "photos" / obj / f"{view}.jpg"
+            shutil.copyfile(source, args.out / f"{obj}_{view}_orig.jpg")
+            photo = read_image(source, "RGB")
+            for name, make in VARIANTS.items():
+                variant = Image.fromarray(np.ascontiguousarray(make(photo)))
+                variant.save(args.out / f"{obj}_{view}_{name}.jpg", quality=90)
+            count += 1 + len(VARIANTS)
+    print(f"{count} photos in {args.out}")
+
+
+if __name__ == "__main__":
+    main()
