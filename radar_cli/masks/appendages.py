@@ -143,28 +143,27 @@ def runs_of(flags: np.ndarray, length: int) -> np.ndarray:
 
 
 def _handle_plates(mask: np.ndarray, axis: float, left: np.ndarray, right: np.ndarray, limit: np.ndarray,
-                   rows: np.ndarray) -> np.ndarray:
+                   rows: np.ndarray, tol: float) -> np.ndarray:
     """`limit` bounded, over the top rows that a handle on each side rises into from below, by the mean of the
     two handles' outer edges just under them (`PLATE_BELOW`): the plates the handles carry reach past the rim.
     Where the object stands above those rows on both sides (volutes), by the handles' inner edges instead.
 
     A side stands apart from the core where its outermost pixel lies past what the core keeps there by more than
-    `SIDE_TOLERANCE` of the object's width (two plates a little unequal are no handle). The rows down to the
-    later of the two handles are the plates' on both sides, and both handles are read from there: a sliver of
-    backdrop under one plate, which a rescaled or mirrored photo may show or not, moves where one handle starts
-    by a few rows, and the handles' outer edges slope fast just under the plates.
+    `tol` (two plates a little unequal are no handle). The rows down to the later of the two handles are the
+    plates' on both sides, and both handles are read from there: a sliver of backdrop under one plate, which a
+    rescaled or mirrored photo may show or not, moves where one handle starts by a few rows, and the handles'
+    outer edges slope fast just under the plates.
 
     Args:
         mask: H x W bool upright silhouette. axis: its axis' x. left, right: H, the axis runs' half-widths
             (`_axis_runs`). limit: H, the per-row half-width bound. rows: the rows holding an axis run.
+        tol: the half-widths' tolerance in pixels (`SIDE_TOLERANCE` of the object's width).
     """
     out = limit.copy()
     height = rows.max() - rows.min() + 1
     outer_l, outer_r = _outer_extents(mask, axis)
     window = np.arange(rows.min(), min(mask.shape[0], rows.min() + int(round(SPIKE_SPAN * height))))
     run = max(2, int(round(PLATE_BELOW[1] * height)))  # a handle: longer than a ragged or lopsided plate
-    cols = np.nonzero(mask.any(0))[0]
-    tol = SIDE_TOLERANCE * (cols.max() - cols.min() + 1)
     kept_l, kept_r = np.fmin(left, limit), np.fmin(right, limit)  # what the core keeps on each side so far
     apart = np.stack([runs_of(outer_l[window] > kept_l[window] + 1.0 + tol, run),
                       runs_of(outer_r[window] > kept_r[window] + 1.0 + tol, run)])  # 2 x n: beside a handle
@@ -233,7 +232,7 @@ def upright_core(mask: np.ndarray, axis: float) -> np.ndarray:
     opened = _opening(radius, int(round(BUMP_SPAN * (rows.max() - rows.min() + 1))))
     limit = np.fmin(radius, _keep_ends(radius, opened, tol, rows)) + tol
     limit = _top_spike(radius, limit, rows)
-    limit = _handle_plates(mask, axis, left, right, limit, rows)
+    limit = _handle_plates(mask, axis, left, right, limit, rows, tol)
     xs = np.arange(mask.shape[1]) + 0.5 - (axis + 0.5)  # pixel centres relative to the axis
     core = np.zeros_like(mask)
     for y in rows[limit[rows] > 0]:
