@@ -16,7 +16,8 @@ from radar_cli.masks.detect import Detection, detect
 from radar_cli.masks.quality import Thresholds, judge, score_mask
 from radar_cli.masks.refine import refine
 
-MIN_PHOTO_SIDE = 64  # photos smaller than this (short edge) cannot give a useful crop
+MIN_PHOTO_SIDE = 64  # photos whose long edge is shorter than this cannot give a useful crop ...
+MIN_PHOTO_SHORT = 16  # ... nor those whose short edge is (a slender vessel's thumbnail, 60 x 190 px, can)
 REFINE_PAD = 1.3  # the refinement window is this much larger than the final crop, so GrabCut sees backdrop
 
 
@@ -88,8 +89,9 @@ def _decoded_scale(rgb: np.ndarray, original: tuple[int, int]) -> float:
 def check_photo(image: np.ndarray, name: str) -> None:
     """Raise InputError if a photo cannot give a crop (too small, or one flat colour)."""
     h, w = image.shape[:2]
-    if min(h, w) < MIN_PHOTO_SIDE:
-        raise InputError(f"{name}: image too small ({w} x {h} px, need >= {MIN_PHOTO_SIDE})")
+    if max(h, w) < MIN_PHOTO_SIDE or min(h, w) < MIN_PHOTO_SHORT:
+        raise InputError(f"{name}: image too small ({w} x {h} px, need >= {MIN_PHOTO_SIDE} on the long edge and "
+                         f">= {MIN_PHOTO_SHORT} on the short)")
     if int(image.max()) - int(image.min()) < 8:
         raise InputError(f"{name}: image is a flat colour, nothing to segment")
 

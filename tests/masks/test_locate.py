@@ -173,6 +173,19 @@ def test_a_plain_solid_has_no_appendages(sources: list) -> None:
         assert split.appendage_fraction < 0.02 and split.symmetry > 0.85
 
 
+def test_a_slender_vessels_thumbnail_under_64_px_wide_is_located() -> None:
+    """A tall slender vessel cut close, as a web thumbnail gives it (60 x 190 px): under 64 px across, still a
+    photo to locate; a photo under 64 px on its long edge is not."""
+    y, x = np.mgrid[0:190, 0:60]
+    half = 22 - 8 * np.exp(-(((y - 30) / 12.0) ** 2))  # a neck under a flaring rim
+    truth = (np.abs(x - 30) <= half) & (y >= 8) & (y <= 182)
+    image = np.where(truth[..., None], np.array([150, 95, 60]), np.array([205, 205, 200])).astype(np.uint8)
+    found = locate_object(image, SIZE)
+    assert crops.reference_iou(found.silhouette | found.appendages, truth, found.box) > 0.85
+    with pytest.raises(InputError, match="too small"):
+        locate_object(image[:60], SIZE)
+
+
 def test_blank_photo_is_one_clear_error() -> None:
     with pytest.raises(InputError, match="blank.png"):
         locate_object(np.full((120, 90, 3), 200, np.uint8), SIZE, "blank.png")
