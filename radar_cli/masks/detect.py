@@ -31,6 +31,9 @@ MIN_REL_AREA = 0.2  # ... and components smaller than this fraction of the large
 GROUP_GAP = 0.03  # components whose boxes come this close (fraction of the long edge) are one object ...
 GROUP_OVERLAP = 0.5  # ... if they also share this fraction of the narrower one's width (a label beside it: not)
 COARSE_ITERATIONS = 4  # GrabCut iterations of the whole-photo pass
+DRIFT_EVIDENCE = 0.9  # evidence this strong inside the seed is object, whatever GrabCut's colour models say ...
+DRIFT_SHARE = 0.25  # ... and a cut that gives more than this share of it to the backdrop has drifted, ...
+DRIFT_SUPPORT = 0.6  # ... where the evidence's own outline lies this much on the photo's edges (`_support`)
 RING = 0.03  # the second backdrop model leaves out this much (fraction of the long edge) around the object
 SEED_SHARE = 0.5  # the backdrop's colour surface is refitted to this best-fitting share of the border band ...
 SEED_ROUNDS = 3  # ... this many times
@@ -216,7 +219,13 @@ def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float,
     """H x W bool object pixels of a detection-scale photo: GrabCut over the whole image, started from the
     evidence (above `threshold`, holes filled: probable object; a thin ring around it: probable backdrop; beyond
     it and `backdrop_seeds` in the border band: sure backdrop). Falls back to the thresholded evidence if
-    GrabCut cannot run or breaks the object up.
+    GrabCut cannot run or breaks the object up; and to it less the sure backdrop if the cut gives more than
+    DRIFT_SHARE of the seed's strongest evidence (above DRIFT_EVIDENCE) to the backdrop while the evidence's own
+    outline lies on the photo's edges (`_support` at least DRIFT_SUPPORT): GrabCut's colour models have drifted
+    (a pale vessel filling the frame's width with a panel painted on it, the backdrop seen only in thin margins:
+    GrabCut keeps the panel and gives the vessel's ground, far from the backdrop's colour, to the backdrop). Where
+    the evidence's outline runs through the backdrop instead (a mottled or shaded backdrop that the evidence
+    took in part), GrabCut's cut stands.
 
     Args:
         image: H x W x 3 uint8 RGB. evidence: H x W in [0, 1] (`foreground_evidence`).
@@ -230,7 +239,8 @@ def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float,
     tri = np.full(raw.shape, cv2.GC_BGD, np.uint8)  # GrabCut trims what the evidence took, it never adds
     tri[reach] = cv2.GC_PR_BGD
     tri[seed] = cv2.GC_PR_FGD
-    tri[backdrop_seeds(image, band)] = cv2.GC_BGD
+    sure = backdrop_seeds(image, band)
+    tri[sure] = cv2.GC_BGD
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
     cv2.setRNGSeed(0)  # GrabCut's k-means draws from a per-thread generator: the same cut in any thread
     try:
@@ -243,7 +253,14 @@ def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float,
     # GrabCut trims backdrop that the evidence took for object; if it breaks a modest object up instead (a flat
     # object seen only by its outline), the evidence stands
     broken = _largest_area(_clean(cut)) < 0.5 * _largest_area(seed) and seed.mean() < 0.5
-    return raw if broken else cut
+    if broken:
+        return raw
+    strong = seed & (evidence > DRIFT_EVIDENCE)
+    if (strong & ~cut).sum() > DRIFT_SHARE * strong.sum():
+        kept = raw & ~sure
+        if _support(image, _clean(kept)) >= DRIFT_SUPPORT:
+            return kept
+    return cut
 
 
 def backdrop_seeds(image: np.ndarray, band: np.ndarray | None = None) -> np.ndarray:
