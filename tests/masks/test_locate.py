@@ -198,6 +198,12 @@ def test_a_pale_vessel_filling_the_width_is_located_whole_not_as_the_panel_paint
     assert found() < 0.6
 
 
+def test_a_plain_solid_has_no_appendages(sources: list) -> None:
+    for _, truth in sources:
+        split = symmetric_core(truth)
+        assert split.appendage_fraction < 0.02 and split.symmetry > 0.85
+
+
 def test_a_slender_vessels_thumbnail_under_64_px_wide_is_located() -> None:
     """A tall slender vessel cut close, as a web thumbnail gives it (60 x 190 px): under 64 px across, still a
     photo to locate; a photo under 64 px on its long edge is not."""
