@@ -3,11 +3,13 @@ splitting off its appendages, on rendered vases pasted over backdrops (the truth
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 
 from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
+from radar_cli.masks import detect
 from radar_cli.masks.appendages import symmetric_core
 from radar_cli.masks.locate import fill_painted_holes, locate_object, open_gaps, remove_stand
 from radar_cli.masks.refine import iou
@@ -172,10 +174,6 @@ def test_a_pale_vessel_filling_the_width_is_located_whole_not_as_the_panel_paint
     thin margins either side: GrabCut's colour models drift until the panel alone is kept (the whole-photo cut
     gives the vessel's ground to the backdrop); its strong evidence, whose outline lies on the vessel's edges,
     stands instead."""
-    import cv2
-
-    from radar_cli.masks import detect
-
     rng = np.random.default_rng(0)
     height, width, margin = 320, 140, 8
     truth = np.zeros((height, width), bool)
