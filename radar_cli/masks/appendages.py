@@ -32,6 +32,8 @@ SPIKE_WIDTH = 0.6  # rows above the rim narrower than this fraction of the rim's
 SPIKE_SPAN = 0.2  # ... where the rim is the widest row within this fraction of the height from the top
 SHELF = 0.25  # ... and the rim widens from them in one row by at least this fraction of its radius
 PLATE_BELOW = (0.02, 0.06)  # a handle's outer edge is read this far under its top (fractions of the height)
+FINE_SIDE = 256  # the axis' tilt is refined on the mask at this side ...
+FINE_STEPS = ((1.0, 3), (0.25, 3))  # ... in these steps (deg), this many each side of the best so far
 
 
 @dataclass(frozen=True)
@@ -85,6 +87,28 @@ def find_axis(mask: np.ndarray) -> tuple[float, float]:
     upright = turn_mask(mask, upright_rotation(mask, best_tilt)) if best_tilt else mask
     _, axis = mirror_agreement(upright)
     return best_tilt, axis
+
+
+def fine_tilt(mask: np.ndarray, around: float) -> tuple[float, float, float]:
+    """The tilt (deg) of the vertical mirror axis that best explains a bool mask, refined from `around` (the
+    coarse tilt of `find_axis`) to FINE_STEPS' last step; and the mask's mirror agreement (IoU with its mirror
+    image, `quality.mirror_agreement`) turned upright by that tilt and as it stands."""
+    k = FINE_SIDE / max(mask.shape)
+    small = cv2.resize(mask.astype(np.uint8), None, fx=k, fy=k, interpolation=cv2.INTER_AREA) > 0
+    if not small.any():
+        return around, 0.0, 0.0
+
+    def agreement(deg: float) -> float:
+        return mirror_agreement(turn_mask(small, upright_rotation(small, deg)) if deg else small)[0]
+
+    scores: dict[float, float] = {}
+    best = around
+    for step, count in FINE_STEPS:
+        for deg in (round(best + i * step, 4) for i in range(-count, count + 1)):
+            if deg not in scores:
+                scores[deg] = agreement(deg)
+        best = max(scores, key=lambda d: (scores[d], -abs(d)))
+    return best, scores[best], scores[0.0] if 0.0 in scores else agreement(0.0)
 
 
 def _axis_runs(mask: np.ndarray, axis: float) -> tuple[np.ndarray, np.ndarray]:

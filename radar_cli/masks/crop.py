@@ -16,11 +16,14 @@ DEFAULT_MARGIN = 0.075  # per side, as a fraction of the crop: the object spans 
 
 @dataclass(frozen=True)
 class CropBox:
-    """A square window of the original photo, in its pixels (may reach outside it; the outside is padded)."""
+    """A square window of the original photo, in its pixels (may reach outside it; the outside is padded),
+    turned by `turn` degrees (counter-clockwise, about the window's centre) where the photo was straightened:
+    the crop shows the photo turned by `turn` so that a vessel's tilted axis stands upright."""
 
     x0: int
     y0: int
     side: int
+    turn: float = 0.0
 
     def to_list(self) -> list[int]:
         return [self.x0, self.y0, self.side]
@@ -51,6 +54,8 @@ def cut(image: np.ndarray, crop: CropBox, size: int, fill: float | None = None) 
     Returns:
         size x size (x C), same dtype.
     """
+    if crop.turn:
+        return _cut_turned(image, crop, size, fill)
     h, w = image.shape[:2]
     x0, y0, x1, y1 = crop.x0, crop.y0, crop.x0 + crop.side, crop.y0 + crop.side
     pad = (max(0, -y0), max(0, y1 - h), max(0, -x0), max(0, x1 - w))
@@ -60,6 +65,41 @@ def cut(image: np.ndarray, crop: CropBox, size: int, fill: float | None = None) 
                   cv2.copyMakeBorder(window, *pad, borderType=cv2.BORDER_CONSTANT, value=[fill] * 4))
     interp = cv2.INTER_AREA if crop.side > size else cv2.INTER_LINEAR
     return cv2.resize(window, (size, size), interpolation=interp)
+
+
+def _cut_turned(image: np.ndarray, crop: CropBox, size: int, fill: float | None) -> np.ndarray:
+    """`cut` of a turned window: the photo shrunk by area first where the crop is smaller (as `cut` does), then
+    turned and sampled bilinearly."""
+    affine = crop_affine(crop, size)
+    k = size / crop.side
+    if k < 1:
+        h, w = image.shape[:2]
+        nw, nh = max(1, round(w * k)), max(1, round(h * k))
+        image = cv2.resize(image, (nw, nh), interpolation=cv2.INTER_AREA)
+        pre = np.array([[w / nw, 0, 0.5 * w / nw - 0.5], [0, h / nh, 0.5 * h / nh - 0.5], [0, 0, 1]])
+        affine = (np.vstack([affine, [0, 0, 1]]) @ pre)[:2]
+    border = {"borderMode": cv2.BORDER_REPLICATE} if fill is None else {
+        "borderMode": cv2.BORDER_CONSTANT, "borderValue": [fill] * 4}
+    return cv2.warpAffine(image, affine, (size, size), flags=cv2.INTER_LINEAR, **border)
+
+
+def turned_photo(image: np.ndarray, deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """An H x W (x C) photo turned by `deg` (counter-clockwise) about its centre onto a canvas that holds all of
+    it, the edge replicated into the corners; and the 2 x 3 affine from the photo's pixels to the canvas'."""
+    h, w = image.shape[:2]
+    c, s = abs(np.cos(np.radians(deg))), abs(np.sin(np.radians(deg)))
+    nw, nh = int(np.ceil(w * c + h * s)), int(np.ceil(w * s + h * c))
+    affine = cv2.getRotationMatrix2D(((w - 1) / 2.0, (h - 1) / 2.0), deg, 1.0)
+    affine[:, 2] += ((nw - w) / 2.0, (nh - h) / 2.0)
+    turned = cv2.warpAffine(image, affine, (nw, nh), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+    return turned, affine
+
+
+def box_in_photo(box: CropBox, affine: np.ndarray, deg: float) -> CropBox:
+    """The window `box` of a turned canvas (`turned_photo`'s affine and angle) as a turned window of the photo."""
+    back = cv2.invertAffineTransform(affine)
+    cx, cy = back @ np.array([box.x0 + box.side / 2.0 - 0.5, box.y0 + box.side / 2.0 - 0.5, 1.0])
+    return CropBox(int(round(cx + 0.5 - box.side / 2.0)), int(round(cy + 0.5 - box.side / 2.0)), box.side, deg)
 
 
 def reference_iou(located: np.ndarray, reference: np.ndarray, crop: CropBox) -> float:
@@ -74,6 +114,11 @@ def reference_iou(located: np.ndarray, reference: np.ndarray, crop: CropBox) -> 
     size = located.shape[0]
     h, w = reference.shape
     truth = cut(reference.astype(np.float32), crop, size, fill=0) > 0.5
+    if crop.turn:  # the reference's share outside the turned window, counted in the crop's pixels
+        seen = cut(reference.astype(np.float32), crop, size, fill=0).sum()
+        missed = max(0.0, float(reference.sum()) * (size / crop.side) ** 2 - float(seen))
+        union = float(np.logical_or(located, truth).sum()) + missed
+        return float(np.logical_and(located, truth).sum()) / union if union else 1.0
     shown = reference[max(0, crop.y0) : min(h, crop.y0 + crop.side), max(0, crop.x0) : min(w, crop.x0 + crop.side)]
     missed = float(reference.sum() - shown.sum()) * (size / crop.side) ** 2
     union = float(np.logical_or(located, truth).sum()) + missed
@@ -82,6 +127,8 @@ def reference_iou(located: np.ndarray, reference: np.ndarray, crop: CropBox) -> 
 
 def outside_mask(crop: CropBox, image_shape: tuple[int, ...], size: int) -> np.ndarray:
     """size x size bool: True on the crop's padding (beyond the photo's edge), False on real photo pixels."""
+    if crop.turn:
+        return cut(np.ones(image_shape[:2], np.float32), crop, size, fill=0) < 0.5
     u0, v0, u1, v1 = valid_region(crop, image_shape, size)
     out = np.ones((size, size), bool)
     out[v0:v1, u0:u1] = False
@@ -115,8 +162,14 @@ def cut_edges(mask: np.ndarray, crop: CropBox, image_shape: tuple[int, ...], min
 
 def crop_affine(crop: CropBox, size: int, scale: float = 1.0) -> np.ndarray:
     """2 x 3 affine taking pixel centres of an image at `scale` x the original's resolution into the crop's
-    size x size pixel grid."""
+    size x size pixel grid (turned with the crop)."""
     k = size / crop.side
+    if crop.turn:
+        centre = (crop.x0 + crop.side / 2.0 - 0.5, crop.y0 + crop.side / 2.0 - 0.5)
+        turn = np.vstack([cv2.getRotationMatrix2D(centre, crop.turn, 1.0), [0, 0, 1]])
+        unturned = np.vstack([crop_affine(CropBox(crop.x0, crop.y0, crop.side), size, 1.0), [0, 0, 1]])
+        to_photo = np.array([[1 / scale, 0, 0.5 / scale - 0.5], [0, 1 / scale, 0.5 / scale - 0.5], [0, 0, 1]])
+        return (unturned @ turn @ to_photo)[:2]
     # original x = (x_s + 0.5) / scale - 0.5 ; crop u = (x - x0 + 0.5) * k - 0.5
     a = k / scale
     bx = (0.5 / scale - 0.5 - crop.x0 + 0.5) * k - 0.5

@@ -12,7 +12,7 @@ import numpy as np
 
 from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
-from radar_cli.masks.appendages import Core, above_rim, find_axis, symmetric_core, upright_rotation
+from radar_cli.masks.appendages import Core, above_rim, find_axis, fine_tilt, symmetric_core, upright_rotation
 from radar_cli.masks.border import frame_inset
 from radar_cli.masks.detect import (
     MIN_AREA_FRAC,
@@ -49,6 +49,9 @@ GAP_MIN = 0.002  # ... seen through the object where they form a patch of at lea
 GAP_DEPTH = 0.08  # ... that comes this close (fraction of the object's width) to its outline ...
 GAP_CONTRAST = 3.0  # ... and lies this many times as far from the object's own colour around it as from the backdrop
 GAP_AROUND = 0.05  # the object's own colour: of its pixels within this share of the window, backdrop-like ones left out
+STRAIGHTEN = (1.5, 6.0)  # an axis leaning this many degrees (at least, at most) is straightened; steeper: no camera
+STRAIGHT_AGREEMENT = 0.93  # ... where the object turned upright agrees with its mirror image this well (a solid) ...
+STRAIGHT_GAIN = 0.025  # ... and this much better than as it stands
 PAINT_AREA = 0.07  # on a greyscale photo a hole this large (share of the object) is paint, wherever it lies
 
 
@@ -282,7 +285,10 @@ def open_gaps(mask: np.ndarray, image: np.ndarray, outside: np.ndarray | None = 
 
 
 def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: float = crops.DEFAULT_MARGIN) -> Located:
-    """Locate the vessel of a photo and cut its square crop around the symmetric core.
+    """Locate the vessel of a photo and cut its square crop around the symmetric core. A vessel whose axis
+    leans by STRAIGHTEN degrees (a camera not quite level, a scan turned on the glass), standing clear of the
+    frame and clearly more symmetric upright (STRAIGHT_AGREEMENT, STRAIGHT_GAIN), is located again on the photo
+    turned upright: its crop is straightened (`box.turn`).
 
     Args:
         photo: H x W x 3 uint8 RGB, or H x W x 4 RGBA (a transparent cut-out's alpha is its silhouette).
@@ -298,6 +304,24 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     top, bottom, left, right = (0, 0, 0, 0) if opaque is not None else frame_inset(rgb)
     rgb = rgb[top : rgb.shape[0] - bottom, left : rgb.shape[1] - right]  # a flat frame round it is no part
     settings = Settings(size=size, margin=margin)
+    found, (tilt, upright_agreement, level_agreement) = _locate(rgb, opaque, settings, name)
+    leans = STRAIGHTEN[0] <= abs(tilt) <= STRAIGHTEN[1]
+    solid = upright_agreement >= max(STRAIGHT_AGREEMENT, level_agreement + STRAIGHT_GAIN)
+    if leans and solid and not found.cut_edges and opaque is None:
+        turned, affine = crops.turned_photo(rgb, tilt)
+        upright, (still, _, _) = _locate(turned, None, settings, name)
+        if not upright.cut_edges and abs(still) < STRAIGHTEN[0]:  # the same vessel, now upright
+            scale = turned.shape[0] * turned.shape[1] / (rgb.shape[0] * rgb.shape[1])
+            found = replace(upright, box=crops.box_in_photo(upright.box, affine, tilt),
+                            frame_coverage=min(1.0, upright.frame_coverage * scale))
+    box = found.box
+    return replace(found, box=replace(box, x0=box.x0 + left, y0=box.y0 + top))  # in the photo with its frame
+
+
+def _locate(rgb: np.ndarray, opaque: np.ndarray | None, settings: Settings, name: str
+            ) -> tuple[Located, tuple[float, float, float]]:
+    """`locate_object` on a photo without its frame (H x W x 3 RGB; a cut-out's H x W bool opaque pixels), as
+    it is; and the tilt (deg) of the located object's axis with its mirror agreements (`appendages.fine_tilt`)."""
     greyscale, kept, painted = False, None, 0.0
     if opaque is not None:
         found = alpha_detection(opaque)
@@ -331,7 +355,7 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     _, _, whole = refined.framed(rgb, mask, settings, box_mask=split.core)
     k = refined.window.side / mask.shape[0]
     coverage = float(mask.sum() * k * k / (rgb.shape[0] * rgb.shape[1]))
-    box = crops.CropBox(final.x0 + left, final.y0 + top, final.side)  # in the photo with its frame
-    return Located(image, core, whole & ~core, box, crops.cut_edges(whole, final, rgb.shape), min(1.0, coverage),
-                   split.symmetry, stand, neighbour, base_off_axis(mask, split.core), above_rim(mask, split.core),
-                   painted, greyscale)
+    located = Located(image, core, whole & ~core, final, crops.cut_edges(whole, final, rgb.shape),
+                      min(1.0, coverage), split.symmetry, stand, neighbour, base_off_axis(mask, split.core),
+                      above_rim(mask, split.core), painted, greyscale)
+    return located, fine_tilt(mask, split.tilt)

@@ -94,6 +94,24 @@ def test_crop_box_recorded(results: Path) -> None:
     assert 65 <= side <= 95 and abs(x0 + side / 2 - 72) < 4 and abs(y0 + side / 2 - 48) < 4
 
 
+def test_a_leaning_photo_is_straightened_and_its_turn_recorded(tmp_path: Path) -> None:
+    from .conftest import FakeModel
+
+    photo = np.full((144, 144, 3), 225, np.uint8)
+    cv2.ellipse(photo, (72, 72), (24, 44), 4.0, 0, 360, (90, 60, 40), -1)  # its axis 4 deg clockwise of vertical
+    (tmp_path / "in").mkdir()
+    cv2.imwrite(str(tmp_path / "in" / "leaning.png"), photo)
+    options = DerenderOptions(out=tmp_path / "out", export=EXPORT, resolution=SIZE)
+    summary = derender([tmp_path / "in"], Predictor(FakeModel(), SETUP, "fake-model", "cpu"), options)
+    assert summary.done == ["leaning"]
+    material = json.loads((tmp_path / "out" / "leaning" / "material.json").read_text())
+    assert material["crop_turn"] == pytest.approx(4.0, abs=1.0)  # turned back counter-clockwise
+    silhouette = np.asarray(Image.open(tmp_path / "out" / "leaning" / "silhouette.png")) > 127
+    rows = np.nonzero(silhouette.any(1))[0]
+    mids = [np.nonzero(silhouette[y])[0].mean() for y in rows]
+    assert abs(np.degrees(np.arctan(np.polyfit(rows, mids, 1)[0]))) < 1.5  # upright in the crop
+
+
 def test_gallery_and_summary(results: Path) -> None:
     page = (results / "index.html").read_text()
     assert "http" not in page  # no network needed

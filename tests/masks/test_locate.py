@@ -232,3 +232,26 @@ def test_a_vessel_under_a_hundredth_of_the_photo_is_one_clear_error(sources: lis
         locate_object(wide, SIZE, "wide.png")
     found = locate_object(wide[900:1300, 1300:1800], SIZE, "cropped.png")  # cropped around it: found
     assert found.silhouette.sum() > 0.1 * SIZE * SIZE
+
+
+def _axis_lean_deg(silhouette: np.ndarray) -> float:
+    """The lean (deg) of the line through a bool silhouette's row midpoints."""
+    rows = np.nonzero(silhouette.any(1))[0]
+    mids = [np.nonzero(silhouette[y])[0].mean() for y in rows]
+    return float(np.degrees(np.arctan(np.polyfit(rows, mids, 1)[0])))
+
+
+def test_a_photo_turned_a_few_degrees_is_straightened_and_its_crop_maps_back_to_the_photo(sources: list) -> None:
+    photo, truth = sources[0]
+    as_drawn = locate_object(photo, SIZE)  # the rendered vase leans a little itself (its camera's roll)
+    h, w = truth.shape
+    # turned so that it leans 4 deg the other way (counter-clockwise: a camera off level)
+    turn = cv2.getRotationMatrix2D(((w - 1) / 2, (h - 1) / 2), as_drawn.box.turn + 4.0, 1.0)
+    tilted = cv2.warpAffine(photo, turn, (w, h), borderMode=cv2.BORDER_REPLICATE)
+    tilted_truth = cv2.warpAffine(truth.astype(np.float32), turn, (w, h)) > 0.5
+    found = locate_object(tilted, SIZE)
+    assert abs(found.box.turn + 4.0) <= 0.75, (found.box.turn, as_drawn.box.turn)
+    assert abs(_axis_lean_deg(found.silhouette)) < 1.0  # upright in the crop
+    assert crops.reference_iou(found.silhouette | found.appendages, tilted_truth, found.box) >= 0.93
+    unturned = crops.CropBox(found.box.x0, found.box.y0, found.box.side)
+    assert crops.reference_iou(found.silhouette | found.appendages, tilted_truth, unturned) < 0.93

@@ -64,6 +64,26 @@ def test_reference_iou_counts_what_the_crop_leaves_out():
     assert crops.reference_iou(found, reference, lower) == pytest.approx(0.5, abs=0.01)
 
 
+def test_a_turned_crop_of_the_photo_is_the_crop_of_the_turned_photo():
+    rng = np.random.default_rng(0)
+    photo = cv2.GaussianBlur(rng.uniform(0, 255, (300, 240)).astype(np.float32), (0, 0), 4)
+    mask = np.zeros((300, 240), bool)
+    cv2.ellipse(mask.view(np.uint8), (110, 160), (50, 100), 20, 0, 360, 1, -1)
+    turned, affine = crops.turned_photo(photo, -20.0)
+    turned_mask = crops.turned_photo(mask.astype(np.float32), -20.0)[0] > 0.5
+    on_canvas = crops.square_box(crops.mask_box(turned_mask))
+    box = crops.box_in_photo(on_canvas, affine, -20.0)
+    assert box.turn == -20.0 and box.side == on_canvas.side
+    direct, via_canvas = crops.cut(photo, box, 96), crops.cut(turned, on_canvas, 96)
+    assert np.abs(direct - via_canvas)[8:-8, 8:-8].mean() < 1.0  # the same window, a half pixel of rounding apart
+    found = crops.cut(turned_mask.astype(np.float32), on_canvas, 96) > 0.5
+    assert crops.reference_iou(found, mask, box) > 0.97  # placed back on the photo as it was
+    assert crops.reference_iou(found, mask, crops.CropBox(box.x0, box.y0, box.side)) < 0.8
+    outside = crops.outside_mask(box, photo.shape, 96)
+    assert not outside[40:56, 40:56].any()
+    assert iou(crops.warp_mask(mask, crops.crop_affine(box, 96), 96), found) > 0.97  # the photo -> crop map
+
+
 def test_crop_pads_outside_the_photo():
     img = np.full((50, 50, 3), 7, np.uint8)
     out = crops.cut(img, crops.CropBox(-20, -20, 100), 64)
