@@ -5,15 +5,20 @@ given more backdrop?
     python -m experiments.photo_variants OUT [--shared ../shared] [--kind whole|fragment]
 
 writes OUT/<object>_<view>_<variant>.jpg for every object of that kind in `cva10/objects.tsv` and each of its
-views but the top view (the 5 whole kraters' 20 side views, or the 8 fragments' outsides and insides), in 7
-variants:
+views but the top view (the 5 whole kraters' 20 side views, or the 8 fragments' outsides and insides), in up to 12
+variants (`--variants` picks some):
 
 - `orig`: the photograph as it is (a copy of the file; the others are written at JPEG quality 90);
 - `half`, `quarter`: scaled to 1/2 and 1/4 (about 850 and 430 px; the quarter is a web image's size);
 - `flip`: mirrored left to right (a solid of revolution's fit should not care);
 - `dark`: every channel raised to the power 1.4 (a darker exposure of the midtones);
 - `tight`: cut to 84 % of the width and 91 % of the height, so the handles or the foot may touch the frame;
-- `wide`: 15 % of the photo's size more backdrop on every side (the border pixels repeated).
+- `wide`: 15 % of the photo's size more backdrop on every side (the border pixels repeated);
+- `bright`: every channel to the power 0.7 (a lighter exposure);
+- `warm`: red up 8 %, blue down 14 % (another white balance);
+- `flat`: contrast to 70 % over a grey haze (a faded scan);
+- `tilt`: turned 3 deg in the image plane (a camera not quite level), the border repeated;
+- `web`: 1/2 size at JPEG quality 40 (a compressed web copy).
 
 Then `radar derender OUT --out R --views 1` and `radar eval-catalog R --dimensions
 ../shared/data/cva10/objects.tsv --drawings docs/data/cva10-profiles` (a result `73AE135_front_half` is matched
@@ -54,18 +59,41 @@ def _wide(image: np.ndarray) -> np.ndarray:
     return cv2.copyMakeBorder(image, dy, dy, dx, dx, cv2.BORDER_REPLICATE)
 
 
-def _dark(image: np.ndarray) -> np.ndarray:
-    return np.clip(255.0 * (image / 255.0) ** 1.4, 0, 255).astype(np.uint8)
+def _gamma(power: float) -> Callable[[np.ndarray], np.ndarray]:
+    def tone(image: np.ndarray) -> np.ndarray:
+        return np.clip(255.0 * (image / 255.0) ** power, 0, 255).astype(np.uint8)
+
+    return tone
+
+
+def _warm(image: np.ndarray) -> np.ndarray:
+    return np.clip(image * np.array([1.08, 1.0, 0.86]), 0, 255).astype(np.uint8)
+
+
+def _flat(image: np.ndarray) -> np.ndarray:
+    return np.clip(0.7 * image.astype(np.float32) + 0.18 * 255, 0, 255).astype(np.uint8)
+
+
+def _tilt(image: np.ndarray) -> np.ndarray:
+    h, w = image.shape[:2]
+    turn = cv2.getRotationMatrix2D((w / 2, h / 2), 3.0, 1.0)
+    return cv2.warpAffine(image, turn, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
 
 
 VARIANTS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
     "half": _scaled(0.5),
     "quarter": _scaled(0.25),
     "flip": lambda image: image[:, ::-1],
-    "dark": _dark,
+    "dark": _gamma(1.4),
     "tight": _tight,
     "wide": _wide,
+    "bright": _gamma(0.7),
+    "warm": _warm,
+    "flat": _flat,
+    "tilt": _tilt,
+    "web": _scaled(0.5),
 }
+QUALITY = {"web": 40}  # variants written at a lower JPEG quality than the others' 90
 
 
 def main() -> None:
@@ -73,6 +101,7 @@ def main() -> None:
     parser.add_argument("out", type=Path)
     parser.add_argument("--shared", type=Path, default=Path("../shared"))
     parser.add_argument("--kind", choices=("whole", "fragment"), default="whole")
+    parser.add_argument("--variants", nargs="+", choices=("orig", *VARIANTS), default=("orig", *VARIANTS))
     args = parser.parse_args()
     cva = args.shared / "data" / "cva10"
     with open(cva / "objects.tsv", newline="") as table:
@@ -83,12 +112,15 @@ def main() -> None:
         obj = row["object"]
         for view in sorted(set(row["views"].split()) - {"top"}):
             source = cva / "photos" / obj / f"{view}.jpg"
-            shutil.copyfile(source, args.out / f"{obj}_{view}_orig.jpg")
+            if "orig" in args.variants:
+                shutil.copyfile(source, args.out / f"{obj}_{view}_orig.jpg")
             photo = read_image(source, "RGB")
             for name, make in VARIANTS.items():
+                if name not in args.variants:
+                    continue
                 variant = Image.fromarray(np.ascontiguousarray(make(photo)))
-                variant.save(args.out / f"{obj}_{view}_{name}.jpg", quality=90)
-            count += 1 + len(VARIANTS)
+                variant.save(args.out / f"{obj}_{view}_{name}.jpg", quality=QUALITY.get(name, 90))
+            count += len(args.variants)
     print(f"{count} photos in {args.out}")
 
 
