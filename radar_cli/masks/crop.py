@@ -71,13 +71,8 @@ def _cut_turned(image: np.ndarray, crop: CropBox, size: int, fill: float | None)
     """`cut` of a turned window: the photo shrunk by area first where the crop is smaller (as `cut` does), then
     turned and sampled bilinearly."""
     affine = crop_affine(crop, size)
-    k = size / crop.side
-    if k < 1:
-        h, w = image.shape[:2]
-        nw, nh = max(1, round(w * k)), max(1, round(h * k))
-        image = cv2.resize(image, (nw, nh), interpolation=cv2.INTER_AREA)
-        pre = np.array([[w / nw, 0, 0.5 * w / nw - 0.5], [0, h / nh, 0.5 * h / nh - 0.5], [0, 0, 1]])
-        affine = (np.vstack([affine, [0, 0, 1]]) @ pre)[:2]
+    if size < crop.side:
+        image, affine = _shrunk_first(image, affine, size / crop.side)
     border = {"borderMode": cv2.BORDER_REPLICATE} if fill is None else {
         "borderMode": cv2.BORDER_CONSTANT, "borderValue": [fill] * 4}
     return cv2.warpAffine(image, affine, (size, size), flags=cv2.INTER_LINEAR, **border)
@@ -113,10 +108,10 @@ def reference_iou(located: np.ndarray, reference: np.ndarray, crop: CropBox) -> 
     """
     size = located.shape[0]
     h, w = reference.shape
-    truth = cut(reference.astype(np.float32), crop, size, fill=0) > 0.5
+    seen = cut(reference.astype(np.float32), crop, size, fill=0)
+    truth = seen > 0.5
     if crop.turn:  # the reference's share outside the turned window, counted in the crop's pixels
-        seen = cut(reference.astype(np.float32), crop, size, fill=0).sum()
-        missed = max(0.0, float(reference.sum()) * (size / crop.side) ** 2 - float(seen))
+        missed = max(0.0, float(reference.sum()) * (size / crop.side) ** 2 - float(seen.sum()))
         union = float(np.logical_or(located, truth).sum()) + missed
         return float(np.logical_and(located, truth).sum()) / union if union else 1.0
     shown = reference[max(0, crop.y0) : min(h, crop.y0 + crop.side), max(0, crop.x0) : min(w, crop.x0 + crop.side)]
@@ -181,14 +176,19 @@ def warp_mask(mask: np.ndarray, affine: np.ndarray, size: int) -> np.ndarray:
     """Warp a bool mask by a 2 x 3 affine into a size x size bool mask (bilinear on 0/1, cut at 0.5)."""
     src: np.ndarray = mask.astype(np.float32)
     if affine[0, 0] < 0.5:  # shrinking: average first so thin parts are not lost to point sampling
-        factor = affine[0, 0]
-        h, w = mask.shape
-        nw, nh = max(1, round(w * factor)), max(1, round(h * factor))
-        src = cv2.resize(src, (nw, nh), interpolation=cv2.INTER_AREA)
-        pre = np.array([[w / nw, 0, 0.5 * w / nw - 0.5], [0, h / nh, 0.5 * h / nh - 0.5], [0, 0, 1]])
-        affine = (np.vstack([affine, [0, 0, 1]]) @ pre)[:2]
+        src, affine = _shrunk_first(src, affine, affine[0, 0])
     out = cv2.warpAffine(src, affine, (size, size), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
     return out > 0.5
+
+
+def _shrunk_first(image: np.ndarray, affine: np.ndarray, factor: float) -> tuple[np.ndarray, np.ndarray]:
+    """An image shrunk by `factor` by area averaging and the 2 x 3 affine that then takes its pixels where
+    `affine` took the original's."""
+    h, w = image.shape[:2]
+    nw, nh = max(1, round(w * factor)), max(1, round(h * factor))
+    small = cv2.resize(image, (nw, nh), interpolation=cv2.INTER_AREA)
+    pre = np.array([[w / nw, 0, 0.5 * w / nw - 0.5], [0, h / nh, 0.5 * h / nh - 0.5], [0, 0, 1]])
+    return small, (np.vstack([affine, [0, 0, 1]]) @ pre)[:2]
 
 
 def valid_region(crop: CropBox, image_shape: tuple[int, ...], size: int) -> tuple[int, int, int, int]:

@@ -63,7 +63,8 @@ class Located:
         image: S x S x 3 uint8 RGB crop (cut-outs composited on white).
         silhouette: S x S bool, the symmetric core (what the network is asked to explain).
         appendages: S x S bool, the rest of the located object (handles, spouts, knobs).
-        box: the crop's square window of the photo (may reach beyond the photo's edge).
+        box: the crop's square window of the photo (may reach beyond the photo's edge), turned where the photo
+            was straightened (`CropBox.turn`).
         cut_edges: the photo edges the object runs into (`top`, `bottom`, `left`, `right`).
         frame_coverage: share of the photo the located object covers.
         symmetry: solid-of-revolution score of the core.
