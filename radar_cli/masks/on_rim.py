@@ -26,7 +26,7 @@ import cv2
 import numpy as np
 
 from radar_cli.masks.neighbours import rounder
-from radar_cli.masks.quality import mirror_iou
+from radar_cli.masks.quality import mirror_iou, solidity
 from radar_cli.masks.refine import main_component, row_extents
 
 RIM_STEP = 0.5  # the run above the rim's top row is under this share of the rim's run ...
@@ -36,7 +36,7 @@ MIN_RISE = 0.05  # ... and rises at least this share of the object's height abov
 SYMMETRIC = 0.55  # ... and its IoU with its mirror image about the axis is under this (a neck and lip are over it)
 DENSE = 0.75  # on a colour photo a denser part, up to this share of its box, is cut too ...
 ASYMMETRIC = 0.3  # ... where its IoU with its mirror image is under this
-COMPACT = 0.87  # a part whose largest piece fills this share of its convex hull or more is a lid's head or knob
+COMPACT = 0.83  # a part whose largest piece fills this share of its convex hull or more is a lid's head or knob
 
 
 def central_runs(mask: np.ndarray, axis: int) -> np.ndarray:
@@ -66,17 +66,6 @@ def rim_top(rows: np.ndarray, runs: np.ndarray) -> int | None:
         if runs[y - 1] < RIM_STEP * runs[y : y + window].max():
             return y
     return None
-
-
-def solidity(part: np.ndarray) -> float:
-    """The share of its convex hull that the largest 8-connected piece of a bool mask fills."""
-    count, labels, stats, _ = cv2.connectedComponentsWithStats(part.astype(np.uint8), connectivity=8)
-    if count < 2:
-        return 0.0
-    piece = (labels == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))).astype(np.uint8)
-    outline, _ = cv2.findContours(piece, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
-    hull = cv2.contourArea(cv2.convexHull(np.concatenate(outline)))
-    return float(piece.sum() / hull) if hull > 0 else 0.0
 
 
 def cut_on_rim(mask: np.ndarray, greyscale: bool = False) -> tuple[np.ndarray, bool]:
@@ -111,7 +100,7 @@ def cut_on_rim(mask: np.ndarray, greyscale: bool = False) -> tuple[np.ndarray, b
     sparse = fill < SPARSE or (not greyscale and fill < DENSE and symmetry < ASYMMETRIC)
     if not sparse or rim - ys.min() < MIN_RISE * (bottom - top + 1) or symmetry >= SYMMETRIC:
         return mask, False
-    if solidity(part) >= COMPACT:  # a head turned aside (a beak, a nose) is lopsided but no bunch of stems
+    if solidity(main_component(part)) >= COMPACT:  # a head turned aside (a beak, a nose): lopsided, no bunch
         return mask, False
     cut = main_component(mask & ~part)
     return (cut, True) if rounder(cut, mask) else (mask, False)
