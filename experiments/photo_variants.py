@@ -5,7 +5,7 @@ given more backdrop?
     python -m experiments.photo_variants OUT [--shared ../shared] [--kind whole|fragment]
 
 writes OUT/<object>_<view>_<variant>.jpg for every object of that kind in `cva10/objects.tsv` and each of its
-views but the top view (the 5 whole kraters' 20 side views, or the 8 fragments' outsides and insides), in up to 12
+views but the top view (the 5 whole kraters' 20 side views, or the 8 fragments' outsides and insides), in up to 13
 variants (`--variants` picks some):
 
 - `orig`: the photograph as it is (a copy of the file; the others are written at JPEG quality 90);
@@ -17,7 +17,8 @@ variants (`--variants` picks some):
 - `bright`: every channel to the power 0.7 (a lighter exposure);
 - `warm`: red up 8 %, blue down 14 % (another white balance);
 - `flat`: contrast to 70 % over a grey haze (a faded scan);
-- `tilt`: turned 3 deg in the image plane (a camera not quite level), the border repeated;
+- `tilt`: turned 3 deg counter-clockwise in the image plane (a camera not quite level), the border repeated;
+- `lean`: turned 4.5 deg clockwise, the same way;
 - `web`: 1/2 size at JPEG quality 40 (a compressed web copy).
 
 Then `radar derender OUT --out R --views 1` and `radar eval-catalog R --dimensions
@@ -74,10 +75,13 @@ def _flat(image: np.ndarray) -> np.ndarray:
     return np.clip(0.7 * image.astype(np.float32) + 0.18 * 255, 0, 255).astype(np.uint8)
 
 
-def _tilt(image: np.ndarray) -> np.ndarray:
-    h, w = image.shape[:2]
-    turn = cv2.getRotationMatrix2D((w / 2, h / 2), 3.0, 1.0)
-    return cv2.warpAffine(image, turn, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+def _turned(deg: float) -> Callable[[np.ndarray], np.ndarray]:
+    def turn(image: np.ndarray) -> np.ndarray:
+        h, w = image.shape[:2]
+        affine = cv2.getRotationMatrix2D((w / 2, h / 2), deg, 1.0)
+        return cv2.warpAffine(image, affine, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+
+    return turn
 
 
 VARIANTS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
@@ -90,7 +94,8 @@ VARIANTS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
     "bright": _gamma(0.7),
     "warm": _warm,
     "flat": _flat,
-    "tilt": _tilt,
+    "tilt": _turned(3.0),
+    "lean": _turned(-4.5),
     "web": _scaled(0.5),
 }
 QUALITY = {"web": 40}  # variants written at a lower JPEG quality than the others' 90
