@@ -106,6 +106,8 @@ def test_a_leaning_photo_is_straightened_and_its_turn_recorded(tmp_path: Path) -
     assert summary.done == ["leaning"]
     material = json.loads((tmp_path / "out" / "leaning" / "material.json").read_text())
     assert material["crop_turn"] == pytest.approx(4.0, abs=1.0)  # turned back counter-clockwise
+    with open(tmp_path / "out" / "summary.csv", newline="") as table:
+        assert float(next(csv.DictReader(table))["crop_turn"]) == material["crop_turn"]
     silhouette = np.asarray(Image.open(tmp_path / "out" / "leaning" / "silhouette.png")) > 127
     rows = np.nonzero(silhouette.any(1))[0]
     mids = [np.nonzero(silhouette[y])[0].mean() for y in rows]

@@ -14,11 +14,11 @@ from radar_cli.fileio import write_text
 from radar_cli.results import FAILURES_FILE, MATERIAL_FILE, SUMMARY_FILE, list_results
 
 SUMMARY_COLUMNS = ("object", "status", "reason", "source", "pitch", "roll", "tx", "ty", "height", "alpha", "rho",
-                   "roughness", "crop_box", "model", "silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction",
-                   "outline_support", "object_symmetry", "outline_residual", "foot_asymmetry", "edge_roughness",
-                   "top_dome", "base_width", "base_spread", "painted_fill", "roundness", "rim_contrast",
-                   "shading_range", "mouth_error", "highlight_excess", "glaring_highlights", "colour_shift", "face",
-                   "cut_edges", "resolution", "refine", "refine_reason", "refine_iou")
+                   "roughness", "crop_box", "crop_turn", "model", "silhouette_iou", "symmetry", "recon_psnr",
+                   "appendage_fraction", "outline_support", "object_symmetry", "outline_residual", "foot_asymmetry",
+                   "edge_roughness", "top_dome", "base_width", "base_spread", "painted_fill", "roundness",
+                   "rim_contrast", "shading_range", "mouth_error", "highlight_excess", "glaring_highlights",
+                   "colour_shift", "face", "cut_edges", "resolution", "refine", "refine_reason", "refine_iou")
 QUALITY_COLUMNS = ("silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction", "outline_support",
                    "object_symmetry", "outline_residual", "foot_asymmetry", "edge_roughness", "top_dome",
                    "base_width", "base_spread", "painted_fill", "roundness", "rim_contrast", "shading_range",
