@@ -77,11 +77,10 @@ def turn_mask(mask: np.ndarray, affine: np.ndarray) -> np.ndarray:
 def find_axis(mask: np.ndarray) -> tuple[float, float]:
     """The tilt (deg, over `quality.TILTS_DEG`) and x (pixels, in the mask rotated upright by that tilt about
     its centroid) of the vertical mirror axis that best explains a bool mask."""
-    k = SCORE_SIDE / max(mask.shape)
-    small = cv2.resize(mask.astype(np.uint8), None, fx=k, fy=k, interpolation=cv2.INTER_AREA) > 0
+    small = _scaled(mask, SCORE_SIDE)
     best, best_tilt = -1.0, 0.0
     for deg in TILTS_DEG:
-        score, _ = mirror_agreement(turn_mask(small, upright_rotation(small, deg)) if deg else small)
+        score = _upright_agreement(small, deg)
         if score > best:
             best, best_tilt = score, deg
     upright = turn_mask(mask, upright_rotation(mask, best_tilt)) if best_tilt else mask
@@ -93,22 +92,28 @@ def fine_tilt(mask: np.ndarray, around: float) -> tuple[float, float, float]:
     """The tilt (deg) of the vertical mirror axis that best explains a bool mask, refined from `around` (the
     coarse tilt of `find_axis`) to FINE_STEPS' last step; and the mask's mirror agreement (IoU with its mirror
     image, `quality.mirror_agreement`) turned upright by that tilt and as it stands."""
-    k = FINE_SIDE / max(mask.shape)
-    small = cv2.resize(mask.astype(np.uint8), None, fx=k, fy=k, interpolation=cv2.INTER_AREA) > 0
+    small = _scaled(mask, FINE_SIDE)
     if not small.any():
         return around, 0.0, 0.0
-
-    def agreement(deg: float) -> float:
-        return mirror_agreement(turn_mask(small, upright_rotation(small, deg)) if deg else small)[0]
-
     scores: dict[float, float] = {}
     best = around
     for step, count in FINE_STEPS:
         for deg in (round(best + i * step, 4) for i in range(-count, count + 1)):
             if deg not in scores:
-                scores[deg] = agreement(deg)
+                scores[deg] = _upright_agreement(small, deg)
         best = max(scores, key=lambda d: (scores[d], -abs(d)))
-    return best, scores[best], scores[0.0] if 0.0 in scores else agreement(0.0)
+    return best, scores[best], scores[0.0] if 0.0 in scores else _upright_agreement(small, 0.0)
+
+
+def _scaled(mask: np.ndarray, side: int) -> np.ndarray:
+    """A bool mask resized (by area) so that its long side is `side`."""
+    k = side / max(mask.shape)
+    return cv2.resize(mask.astype(np.uint8), None, fx=k, fy=k, interpolation=cv2.INTER_AREA) > 0
+
+
+def _upright_agreement(mask: np.ndarray, deg: float) -> float:
+    """`quality.mirror_agreement` of a bool mask turned by `deg` about its centroid."""
+    return mirror_agreement(turn_mask(mask, upright_rotation(mask, deg)) if deg else mask)[0]
 
 
 def _axis_runs(mask: np.ndarray, axis: float) -> tuple[np.ndarray, np.ndarray]:

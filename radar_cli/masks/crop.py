@@ -112,10 +112,9 @@ def reference_iou(located: np.ndarray, reference: np.ndarray, crop: CropBox) -> 
     truth = seen > 0.5
     if crop.turn:  # the reference's share outside the turned window, counted in the crop's pixels
         missed = max(0.0, float(reference.sum()) * (size / crop.side) ** 2 - float(seen.sum()))
-        union = float(np.logical_or(located, truth).sum()) + missed
-        return float(np.logical_and(located, truth).sum()) / union if union else 1.0
-    shown = reference[max(0, crop.y0) : min(h, crop.y0 + crop.side), max(0, crop.x0) : min(w, crop.x0 + crop.side)]
-    missed = float(reference.sum() - shown.sum()) * (size / crop.side) ** 2
+    else:
+        shown = reference[max(0, crop.y0) : min(h, crop.y0 + crop.side), max(0, crop.x0) : min(w, crop.x0 + crop.side)]
+        missed = float(reference.sum() - shown.sum()) * (size / crop.side) ** 2
     union = float(np.logical_or(located, truth).sum()) + missed
     return float(np.logical_and(located, truth).sum()) / union if union else 1.0
 
