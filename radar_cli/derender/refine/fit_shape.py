@@ -25,7 +25,7 @@ from radar_cli.config import CameraConfig
 from radar_cli.derender.refine.adam import Adam
 from radar_cli.derender.refine.bands import band_coherence, high_pass
 from radar_cli.derender.refine.hidden_rows import smooth_hidden
-from radar_cli.derender.refine.pitch_cues import lip_contrast, pick_cue, top_error
+from radar_cli.derender.refine.pitch_cues import lip_contrast, pick_cue, straight_contrast, top_error
 from radar_cli.derender.refine.shape_config import ShapeFitConfig
 from radar_cli.sor.outline import Outline, mask_outline, outline, vertical_extent
 from radar_cli.sor.pose import rotation_matrix, translation
@@ -163,17 +163,37 @@ def closed_form(target: Outline, size: int, pitches: torch.Tensor, roll: float, 
 
 
 def _search(target: Outline, grey: torch.Tensor, size: int, pitches: torch.Tensor, roll: float, tx: float,
-            config: ShapeFitConfig, camera: CameraConfig, lip_offset_px: float
+            config: ShapeFitConfig, camera: CameraConfig, lip_offset_px: float, straight: bool = False
             ) -> tuple[tuple[torch.Tensor, torch.Tensor, torch.Tensor], torch.Tensor, torch.Tensor, torch.Tensor,
                        torch.Tensor, torch.Tensor]:
-    """Score a grid of candidate pitches: (shapes, outline + bending scores B, lip contrasts B, top-edge
-    errors B, outline + uncapped bending B, lip contrasts relative to their sides' grey level B, 0 where less than
-    config.lip_share of the arc is darker above)."""
+    """Score a grid of candidate pitches: (shapes, outline + bending scores B, lip contrasts B (0 where a level
+    line draws the edge as well, `straight`: _not_straight), top-edge errors B, outline + uncapped bending B, lip
+    contrasts relative to their sides' grey level B, 0 where less than config.lip_share of the arc is darker
+    above)."""
     radius, height, pose = closed_form(target, size, pitches, roll, tx, config, camera)
     score, top, smooth = _outline_scores(target, size, radius, height, pose, config, camera)
     contrast, level, share = lip_contrast(grey, radius, height, pose, lip_offset_px, camera)
+    if straight:
+        contrast = _not_straight(contrast, grey, (radius, height, pose), lip_offset_px, config, camera)
     relative = torch.where(share >= config.lip_share, contrast / (level + config.lip_dark), torch.zeros_like(level))
     return (radius, height, pose), score, contrast, top, smooth, relative
+
+
+def _not_straight(contrast: torch.Tensor, grey: torch.Tensor, shapes: tuple[torch.Tensor, torch.Tensor, torch.Tensor],
+                  offset_px: float, config: ShapeFitConfig, camera: CameraConfig) -> torch.Tensor:
+    """B lip contrasts, 0 for the candidates whose arc rises at least config.straight_rise_px and whose contrast a
+    level line across it matches within config.straight_ratio (pitch_cues.straight_contrast: the edge is
+    straight, as the rim and neck of a level photograph are, not the rim's front arc). Only candidates with a
+    positive contrast are looked at."""
+    if config.straight_ratio is None:
+        return contrast
+    some = torch.nonzero(contrast > 0).flatten()
+    if not len(some):
+        return contrast
+    radius, height, pose = shapes
+    line, rise = straight_contrast(grey, radius[some], height[some], pose[some], offset_px, camera)
+    straight = (rise >= config.straight_rise_px) & (line >= config.straight_ratio * contrast[some])
+    return contrast.index_put((some[straight],), torch.zeros_like(contrast[some[straight]]))
 
 
 def _outline_scores(target: Outline, size: int, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
@@ -231,7 +251,7 @@ def search_pitch(target: Outline, grey: torch.Tensor, size: int, config: ShapeFi
     roll, tx = axis_from_outline(target, size, camera)
     coarse = torch.arange(0.0, config.pitch_max + 1e-6, config.coarse_step, dtype=torch.float64)
     shapes, score, contrast, top, smooth, relative = _search(target, grey, size, coarse, roll, tx, config, camera,
-                                                             config.lip_offset_px)
+                                                             config.lip_offset_px, straight=True)
     shapes, (score, top, smooth) = _second_look(target, size, shapes, (score, top, smooth), contrast, relative,
                                                 config, camera)
     coherence = None if bands is None else band_coherence(bands[0], bands[1], *shapes, config.bands, camera)

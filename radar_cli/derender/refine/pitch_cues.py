@@ -18,6 +18,36 @@ from radar_cli.sor.outline import Outline, disc_conics
 from radar_cli.sor.solid import Solid
 
 
+def _front_arc(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, camera: CameraConfig, samples: int
+               ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """The rim's front arc: x (N normalised columns), y (B x N, normalised, up; NaN off the rim's ellipse) and
+    the columns of its middle 80 % (B x N bool)."""
+    q = disc_conics(Solid(radius, height, pose), 2, camera)[:, 0]  # B x 3 x 3, the top disc
+    x = torch.linspace(-1, 1, samples, dtype=torch.float64)
+    # per column, the lower root y of the top disc's conic (y up)
+    front, _ = roots(q[:, 1, 1, None].expand(-1, samples), q[:, 0, 1, None] * x + q[:, 1, 2, None],
+                     q[:, 0, 0, None] * x * x + 2 * q[:, 0, 2, None] * x + q[:, 2, 2, None])  # B x N
+    covered = ~front.isnan()
+    lo = torch.where(covered, x, torch.full_like(front, math.inf)).amin(1, keepdim=True)
+    hi = torch.where(covered, x, torch.full_like(front, -math.inf)).amax(1, keepdim=True)
+    return x, front, covered & ((x - (lo + hi) / 2).abs() <= 0.4 * (hi - lo))
+
+
+def _edge(grey: torch.Tensor, x: torch.Tensor, y: torch.Tensor, use: torch.Tensor, offset_px: float
+          ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Per curve (B x N heights y at columns x, normalised, up; its `use`d columns): the grey level just below
+    minus just above (B x N), their mean (B x N) and where both sides lie well inside the silhouette (B x N bool).
+    grey: 1 x 2 x S x S, the grey image and the object's coverage."""
+    step = offset_px * 2 / 512
+    y = torch.nan_to_num(y)
+    points = torch.stack([torch.stack([x.expand_as(y), -(y + step)], -1),  # above the curve; rows down
+                          torch.stack([x.expand_as(y), -(y - step)], -1)], 1)  # below it
+    values = F.grid_sample(grey.expand(len(y), -1, -1, -1), points.float(), align_corners=False)  # B x 2 x 2 x N
+    on_object = use & (values[:, 1].amin(dim=1) > 0.99)
+    return ((values[:, 0, 1] - values[:, 0, 0]).double() * on_object,
+            (values[:, 0, 1] + values[:, 0, 0]).double() / 2 * on_object, on_object)
+
+
 def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
                  offset_px: float, camera: CameraConfig, samples: int = 512
                  ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
@@ -34,29 +64,39 @@ def lip_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor,
         (B contrasts, B levels, B shares), all 0 where the rim's ellipse has no width, i.e. seen edge on, or
         where less than half of the arc's samples lie on the object.
     """
-    q = disc_conics(Solid(radius, height, pose), 2, camera)[:, 0]  # B x 3 x 3, the top disc
-    x = torch.linspace(-1, 1, samples, dtype=torch.float64)
-    # the rim's front arc: per column, the lower root y of the top disc's conic (y up)
-    front, _ = roots(q[:, 1, 1, None].expand(-1, samples), q[:, 0, 1, None] * x + q[:, 1, 2, None],
-                     q[:, 0, 0, None] * x * x + 2 * q[:, 0, 2, None] * x + q[:, 2, 2, None])  # B x N
-    covered = ~front.isnan()
-    lo = torch.where(covered, x, torch.full_like(front, math.inf)).amin(1, keepdim=True)
-    hi = torch.where(covered, x, torch.full_like(front, -math.inf)).amax(1, keepdim=True)
-    use = covered & ((x - (lo + hi) / 2).abs() <= 0.4 * (hi - lo))  # B x N
-    step = offset_px * 2 / 512
-    y = torch.nan_to_num(front)
-    points = torch.stack([torch.stack([x.expand_as(y), -(y + step)], -1),  # above the arc (inside); rows down
-                          torch.stack([x.expand_as(y), -(y - step)], -1)], 1)  # below the arc (outer wall)
-    values = F.grid_sample(grey.expand(len(y), -1, -1, -1), points.float(), align_corners=False)  # B x 2 x 2 x N
-    on_object = use & (values[:, 1].amin(dim=1) > 0.99)  # both sides well inside the silhouette
-    diff = (values[:, 0, 1] - values[:, 0, 0]).double() * on_object
-    level = (values[:, 0, 1] + values[:, 0, 0]).double() / 2 * on_object
+    x, front, use = _front_arc(radius, height, pose, camera, samples)
+    diff, level, on_object = _edge(grey, x, front, use, offset_px)
     enough = on_object.sum(1) >= 0.5 * use.sum(1).clamp_min(1)
     count = on_object.sum(1).clamp_min(1)
     share = ((diff > 0) & on_object).sum(1) / count
     zero = torch.zeros_like(diff[:, 0])
     return (torch.where(enough, diff.sum(1) / count, zero), torch.where(enough, level.sum(1) / count, zero),
             torch.where(enough, share, zero))
+
+
+def straight_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
+                      offset_px: float, camera: CameraConfig, samples: int = 512
+                      ) -> tuple[torch.Tensor, torch.Tensor]:
+    """The strongest contrast (as lip_contrast) of a level line across the columns of each candidate's front
+    arc, at any height the arc spans (1 px steps at 512 px, offset_px beyond its ends), and the arc's rise over
+    those columns (px at 512): B each. A level photograph's rim or neck has straight edges; an arc that crosses
+    one has some contrast, which a line along the edge beats."""
+    x, front, use = _front_arc(radius, height, pose, camera, samples)
+    px = 2 / 512
+    arc = torch.where(use, front, torch.full_like(front, math.nan))
+    low = torch.where(use, front, torch.full_like(front, math.inf)).amin(1)  # B
+    high = torch.where(use, front, torch.full_like(front, -math.inf)).amax(1)
+    rise = ((high - low) / px).nan_to_num(0.0, posinf=0.0, neginf=0.0).clamp_min(0.0)
+    steps = int(rise.max()) + 2 * math.ceil(offset_px) + 1 if use.any() else 0
+    best = torch.zeros(len(front), dtype=torch.float64)
+    for k in range(steps):
+        level = (low - (math.ceil(offset_px) - k) * px).nan_to_num(0.0, posinf=0.0, neginf=0.0)  # B
+        line = level[:, None].expand_as(arc)
+        inside = use & (level[:, None] <= high[:, None] + offset_px * px)
+        diff, _, on_object = _edge(grey, x, line, inside, offset_px)
+        enough = on_object.sum(1) >= 0.5 * use.sum(1).clamp_min(1)
+        best = torch.where(enough, torch.maximum(best, diff.sum(1) / on_object.sum(1).clamp_min(1)), best)
+    return best, rise
 
 
 def top_error(model: Outline, target: Outline) -> torch.Tensor:
