@@ -6,7 +6,7 @@ given more backdrop?
 
 writes OUT/<object>_<view>_<variant>.jpg for every object of that kind in `cva10/objects.tsv` and each of its
 views but the top view (the 5 whole kraters' 20 side views, or the 8 fragments' outsides and insides), in up to 13
-variants (`--variants` picks some):
+variants, and six that combine them (`--variants` picks some):
 
 - `orig`: the photograph as it is (a copy of the file; the others are written at JPEG quality 90);
 - `half`, `quarter`: scaled to 1/2 and 1/4 (about 850 and 430 px; the quarter is a web image's size);
@@ -19,7 +19,11 @@ variants (`--variants` picks some):
 - `flat`: contrast to 70 % over a grey haze (a faded scan);
 - `tilt`: turned 3 deg counter-clockwise in the image plane (a camera not quite level), the border repeated;
 - `lean`: turned 4.5 deg clockwise, the same way;
-- `web`: 1/2 size at JPEG quality 40 (a compressed web copy).
+- `web`: 1/2 size at JPEG quality 40 (a compressed web copy);
+- `cool`: red down 8 %, blue up 12 % (the other way from `warm`);
+- `ramp`: lit unevenly, from 0.8 on the left to 1.1 on the right (every channel);
+- `darkwarm`, `darkhalf`, `warmflip`, `brightquarter`: `dark` then `warm`; the power 1.3 at 1/2 size; `warm`
+  mirrored; the power 0.75 at 1/4 size.
 
 Then `radar derender OUT --out R --views 1` and `radar eval-catalog R --dimensions
 ../shared/data/cva10/objects.tsv --drawings docs/data/cva10-profiles` (a result `73AE135_front_half` is matched
@@ -75,6 +79,15 @@ def _flat(image: np.ndarray) -> np.ndarray:
     return np.clip(0.7 * image.astype(np.float32) + 0.18 * 255, 0, 255).astype(np.uint8)
 
 
+def _cool(image: np.ndarray) -> np.ndarray:
+    return np.clip(image * np.array([0.92, 1.0, 1.12]), 0, 255).astype(np.uint8)
+
+
+def _ramp(image: np.ndarray) -> np.ndarray:
+    light = np.linspace(0.8, 1.1, image.shape[1])[None, :, None]
+    return np.clip(image * light, 0, 255).astype(np.uint8)
+
+
 def _turned(deg: float) -> Callable[[np.ndarray], np.ndarray]:
     def turn(image: np.ndarray) -> np.ndarray:
         h, w = image.shape[:2]
@@ -97,6 +110,12 @@ VARIANTS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
     "tilt": _turned(3.0),
     "lean": _turned(-4.5),
     "web": _scaled(0.5),
+    "cool": _cool,
+    "ramp": _ramp,
+    "darkwarm": lambda image: _warm(_gamma(1.4)(image)),
+    "darkhalf": lambda image: _scaled(0.5)(_gamma(1.3)(image)),
+    "warmflip": lambda image: _warm(image[:, ::-1]),
+    "brightquarter": lambda image: _scaled(0.25)(_gamma(0.75)(image)),
 }
 QUALITY = {"web": 40}  # variants written at a lower JPEG quality than the others' 90
 
