@@ -182,9 +182,9 @@ def _search(target: Outline, grey: torch.Tensor, size: int, pitches: torch.Tenso
 def _not_straight(contrast: torch.Tensor, grey: torch.Tensor, shapes: tuple[torch.Tensor, torch.Tensor, torch.Tensor],
                   offset_px: float, config: ShapeFitConfig, camera: CameraConfig) -> torch.Tensor:
     """B lip contrasts, 0 for the candidates whose arc rises at least config.straight_rise_px and whose contrast a
-    level line across it matches within config.straight_ratio (pitch_cues.straight_contrast: the edge is
-    straight, as the rim and neck of a level photograph are, not the rim's front arc). Only candidates with a
-    positive contrast are looked at."""
+    level line across it reaches config.straight_ratio times (pitch_cues.straight_contrast: the edge is straight,
+    as the rim and neck of a level photograph are, not the rim's front arc). Only candidates with a positive
+    contrast are looked at."""
     if config.straight_ratio is None:
         return contrast
     some = torch.nonzero(contrast > 0).flatten()

@@ -55,12 +55,12 @@ class ShapeFitConfig:
             at most 0.85 (a decorated neck or rim crosses them).
         lip_share: see lip_relative.
         straight_ratio, straight_rise_px: on the coarse grid, an arc rising at least straight_rise_px (px at 512
-            px) over its middle 80 % whose contrast a level line across the same columns matches within
-            straight_ratio (pitch_cues.straight_contrast) is no lip (None: not checked). A level photograph's rim
-            and neck meet in straight edges, which the arcs of steep candidates cross: on the CVA 10 side views
-            (and lighter, darker, warmer copies) such arcs read 0.10-0.15 and their best line 1.2-2.5 x that,
-            while the open mouths of 120 synthetic vases at 512 px (seeds 5, 7, 31) read at most 1.08 x on the
-            arcs that picked their pitch.
+            px) over its middle 80 % whose contrast a level line across the same columns reaches straight_ratio
+            times (pitch_cues.straight_contrast) is no lip (None: not checked). A level photograph's rim and neck
+            meet in straight edges, which the arcs of steep candidates cross: on the CVA 10 side views (and
+            lighter, darker, warmer copies) such arcs read 0.10-0.15 and their best line 1.2-2.5 x that, while
+            the open mouths of 120 synthetic vases at 512 px (seeds 5, 7, 31) read 0.55-0.98 x on the arcs that
+            picked their pitch (one 1.08 x, beside a neighbour at 0.92 that picks instead).
         lip_dark: grey level added to the sides' mean before dividing (two black sides make no lip).
         dark_lip_bands: the relative lip picks only among candidates whose painted bands' coherence is at least
             this share of the basin's highest (bands too faint to pick still say which pitches they rule out:
@@ -92,7 +92,7 @@ class ShapeFitConfig:
     lip_tie: float = 0.9
     lip_relative: float | None = 0.35
     lip_share: float = 0.9
-    straight_ratio: float | None = 1.15
+    straight_ratio: float | None = 1.0
     straight_rise_px: float = 6.0
     lip_dark: float = 0.02
     dark_lip_bands: float | None = 0.6
