@@ -83,7 +83,6 @@ def straight_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Te
     one has some contrast, which a line along the edge beats."""
     x, front, use = _front_arc(radius, height, pose, camera, samples)
     px = 2 / 512
-    arc = torch.where(use, front, torch.full_like(front, math.nan))
     low = torch.where(use, front, torch.full_like(front, math.inf)).amin(1)  # B
     high = torch.where(use, front, torch.full_like(front, -math.inf)).amax(1)
     rise = ((high - low) / px).nan_to_num(0.0, posinf=0.0, neginf=0.0).clamp_min(0.0)
@@ -91,7 +90,7 @@ def straight_contrast(grey: torch.Tensor, radius: torch.Tensor, height: torch.Te
     best = torch.zeros(len(front), dtype=torch.float64)
     for k in range(steps):
         level = (low - (math.ceil(offset_px) - k) * px).nan_to_num(0.0, posinf=0.0, neginf=0.0)  # B
-        line = level[:, None].expand_as(arc)
+        line = level[:, None].expand_as(front)
         inside = use & (level[:, None] <= high[:, None] + offset_px * px)
         diff, _, on_object = _edge(grey, x, line, inside, offset_px)
         enough = on_object.sum(1) >= 0.5 * use.sum(1).clamp_min(1)
