@@ -5,8 +5,8 @@ given more backdrop?
     python -m experiments.photo_variants OUT [--shared ../shared] [--kind whole|fragment]
 
 writes OUT/<object>_<view>_<variant>.jpg for every object of that kind in `cva10/objects.tsv` and each of its
-views but the top view (the 5 whole kraters' 20 side views, or the 8 fragments' outsides and insides), in up to 13
-variants, and six that combine them (`--variants` picks some):
+views but the top view (the 5 whole kraters' 20 side views, or the 8 fragments' outsides and insides), in up to 22
+variants (`--variants` picks some):
 
 - `orig`: the photograph as it is (a copy of the file; the others are written at JPEG quality 90);
 - `half`, `quarter`: scaled to 1/2 and 1/4 (about 850 and 430 px; the quarter is a web image's size);
@@ -23,7 +23,9 @@ variants, and six that combine them (`--variants` picks some):
 - `cool`: red down 8 %, blue up 12 % (the other way from `warm`);
 - `ramp`: lit unevenly, from 0.8 on the left to 1.1 on the right (every channel);
 - `darkwarm`, `darkhalf`, `warmflip`, `brightquarter`: `dark` then `warm`; the power 1.3 at 1/2 size; `warm`
-  mirrored; the power 0.75 at 1/4 size.
+  mirrored; the power 0.75 at 1/4 size;
+- `grey`: greyscale (luma, as an older catalogue's plate); `blur`: out of focus (Gaussian, sigma 2.5 px); `noise`:
+  sensor noise (Gaussian, sigma 8 levels, the same draw for every photo).
 
 Then `radar derender OUT --out R --views 1` and `radar eval-catalog R --dimensions
 ../shared/data/cva10/objects.tsv --drawings docs/data/cva10-profiles` (a result `73AE135_front_half` is matched
@@ -88,6 +90,16 @@ def _ramp(image: np.ndarray) -> np.ndarray:
     return np.clip(image * light, 0, 255).astype(np.uint8)
 
 
+def _grey(image: np.ndarray) -> np.ndarray:
+    luma = image.astype(np.float32) @ np.array([0.299, 0.587, 0.114], np.float32)
+    return np.repeat(np.clip(luma, 0, 255).astype(np.uint8)[..., None], 3, axis=2)
+
+
+def _noise(image: np.ndarray) -> np.ndarray:
+    grain = np.random.default_rng(0).normal(0.0, 8.0, image.shape)
+    return np.clip(image + grain, 0, 255).astype(np.uint8)
+
+
 def _turned(deg: float) -> Callable[[np.ndarray], np.ndarray]:
     def turn(image: np.ndarray) -> np.ndarray:
         h, w = image.shape[:2]
@@ -116,6 +128,9 @@ VARIANTS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
     "darkhalf": lambda image: _scaled(0.5)(_gamma(1.3)(image)),
     "warmflip": lambda image: _warm(image[:, ::-1]),
     "brightquarter": lambda image: _scaled(0.25)(_gamma(0.75)(image)),
+    "grey": _grey,
+    "blur": lambda image: cv2.GaussianBlur(image, (0, 0), 2.5),
+    "noise": _noise,
 }
 QUALITY = {"web": 40}  # variants written at a lower JPEG quality than the others' 90
 
