@@ -41,6 +41,7 @@ def test_a_good_result_is_ok() -> None:
     ({"painted_fill": 0.1}, "review", "as grey as the backdrop"),
     ({"greyscale": True, "object_symmetry": 0.82}, "review", "not quite symmetric"),
     ({"foot_asymmetry": 0.05}, "review", "not a foot's level arc"),
+    ({"foot_aside": 0.06}, "review", "one side of the foot stands beside the solid"),
     ({"edge_roughness": 0.002}, "review", "lower outline is jagged"),
     ({"top_dome": 0.25}, "review", "dome above a neck"),
     ({"base_width": 0.16, "base_spread": 1.0}, "review", "narrow stem"),

@@ -1,6 +1,6 @@
 """The whole-object scores of masks.quality: how far a solid's outline is off a silhouette, how round a
 silhouette is, how uneven or jagged its lower outline is, whether its top closes in a dome, how much of it
-stands on the rim left out of the core, how narrow it ends below."""
+stands on the rim left out of the core, how much of its foot stands beside the solid, how narrow it ends below."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import numpy as np
 from radar_cli.masks.appendages import above_rim
 from radar_cli.masks.quality import (
     edge_roughness,
+    foot_aside,
     foot_asymmetry,
     outline_residual,
     roundness,
@@ -54,6 +55,32 @@ def test_a_foot_is_symmetric_even_where_the_solid_misses_it() -> None:
     assert foot_asymmetry(_vase(), _vase()) == 0.0
     assert foot_asymmetry(_vase(36), _vase(26)) < 0.005  # a solid drawing the foot too narrow, on both sides
     assert foot_asymmetry(np.zeros((10, 10), bool), _vase()) is None
+
+
+def test_a_foot_side_left_out_of_the_core_is_measured_and_a_shadow_is_not() -> None:
+    """The foot's left side lost in the photo (a restoration of the backdrop's tone): the core keeps each row's
+    shorter side, so the foot's right side is left out as an appendage as tall as the foot. A shadow on the floor
+    is a flat sliver, a label beside the foot stands far out, a handle sits higher."""
+    whole = np.zeros((200, 200), np.uint8)
+    cv2.ellipse(whole, (100, 90), (60, 60), 0, 0, 360, 1, -1)  # the body, rows 30-150
+    whole[150:158, 85:116] = 1  # a stem
+    whole[158:177, 65:136] = 1  # the foot, 71 px wide
+    whole = whole > 0
+    whole[158:177, 65:71] = False  # its left end lost
+    core = whole.copy()
+    core[158:177, 130:] = False  # ... so the core's foot ends as short on the right
+    app = whole & ~core
+    assert 0.05 < foot_aside(app, whole, core) < 0.15
+    shadow = np.zeros_like(whole)
+    shadow[175:177, 130:160] = True  # 2 rows of the foot's 18
+    assert foot_aside(shadow, _vase() | shadow, _vase()) == 0.0
+    label = np.zeros_like(whole)
+    label[160:177, 136:170] = True  # a card beside the foot, reaching out as far as the foot's half-width
+    assert foot_aside(label, _vase() | label, _vase()) == 0.0
+    handle = np.zeros_like(whole)
+    handle[50:110, 160:170] = True
+    assert foot_aside(handle, _vase() | handle, _vase()) == 0.0
+    assert foot_aside(np.zeros_like(whole), _vase(), _vase()) == 0.0
 
 
 def _broken(line: np.ndarray) -> float | None:

@@ -27,6 +27,7 @@ from radar_cli.masks.neighbours import BASE_MERGED
 from radar_cli.masks.outline import outline_support
 from radar_cli.masks.quality import (
     edge_roughness,
+    foot_aside,
     foot_asymmetry,
     outline_residual,
     roundness,
@@ -71,6 +72,9 @@ class QualityLimits:
     review_foot: float = 0.03
     """The object's lower outline further than this share of its height from mirror-symmetric about the solid's
     axis (`foot_asymmetry`): review (a broken edge or a sherd, not a foot)."""
+    review_foot_aside: float = 0.05
+    """A part of the foot's side as tall as the foot and larger than this share of the solid's foot, left out
+    of the solid (`foot_aside`): review (the other side was lost, so the foot is drawn too narrow)."""
     review_roughness: float = 0.0008
     """The object's lower outline departing from its running median by more than this share of its height
     (`edge_roughness`): review (a jagged break, not a foot)."""
@@ -192,6 +196,7 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
         "object_symmetry": None if whole is None else _round(sor_score(whole)),
         "outline_residual": None if sil is None else _round(outline_residual(sil, rendered)),
         "foot_asymmetry": None if whole is None else _round(foot_asymmetry(whole, rendered)),
+        "foot_aside": None if app is None or whole is None else _round(foot_aside(app, whole, rendered)),
         "edge_roughness": None if whole is None else _round(edge_roughness(whole, rendered), 5),
         "top_dome": None if sil is None else _round(top_dome(sil)),
         "base_width": None if base is None else _round(base[0]),
@@ -262,6 +267,9 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
         ("foot_asymmetry", lambda v: v > limits.review_foot,
          "the lower outline is uneven, not a foot's level arc ({:.1%} of the height off its mirror image): a "
          "broken edge or a sherd?"),
+        ("foot_aside", lambda v: v > limits.review_foot_aside,
+         "one side of the foot stands beside the solid ({:.2f} of its foot): the other side is lost in the photo "
+         "(chipped, restored, or as pale as the backdrop), so the foot is drawn too narrow"),
         ("edge_roughness", lambda v: v > limits.review_roughness,
          "the lower outline is jagged ({:.2%} of the height off its smooth course), not a foot's arc: a break?"),
         ("top_dome", lambda v: v > limits.review_dome,

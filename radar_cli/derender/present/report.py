@@ -16,11 +16,11 @@ from radar_cli.results import FAILURES_FILE, MATERIAL_FILE, SUMMARY_FILE, list_r
 SUMMARY_COLUMNS = ("object", "status", "reason", "source", "pitch", "roll", "tx", "ty", "height", "alpha", "rho",
                    "roughness", "crop_box", "crop_turn", "model", "silhouette_iou", "symmetry", "recon_psnr",
                    "appendage_fraction", "outline_support", "object_symmetry", "outline_residual", "foot_asymmetry",
-                   "edge_roughness", "top_dome", "base_width", "base_spread", "painted_fill", "roundness",
+                   "foot_aside", "edge_roughness", "top_dome", "base_width", "base_spread", "painted_fill", "roundness",
                    "rim_contrast", "shading_range", "mouth_error", "highlight_excess", "glaring_highlights",
                    "colour_shift", "face", "cut_edges", "resolution", "refine", "refine_reason", "refine_iou")
 QUALITY_COLUMNS = ("silhouette_iou", "symmetry", "recon_psnr", "appendage_fraction", "outline_support",
-                   "object_symmetry", "outline_residual", "foot_asymmetry", "edge_roughness", "top_dome",
+                   "object_symmetry", "outline_residual", "foot_asymmetry", "foot_aside", "edge_roughness", "top_dome",
                    "base_width", "base_spread", "painted_fill", "roundness", "rim_contrast", "shading_range",
                    "mouth_error", "highlight_excess", "glaring_highlights", "colour_shift", "face")
 STATUS_ORDER = {"failed": 0, "review": 1, "ok": 2}  # worst first; objects without a quality record come last
