@@ -44,8 +44,7 @@ def from_results(folder: Path) -> tuple[crops.CropBox, np.ndarray, np.ndarray] |
     record = folder / "material.json"
     if not record.is_file():
         return None
-    material = json.loads(record.read_text())
-    box = crops.CropBox(*material["crop_box"], float(material.get("crop_turn", 0.0)))
+    box = crops.CropBox.from_record(json.loads(record.read_text()))
     core = read_image(folder / "silhouette.png", "L") > 127
     extra = folder / "appendages.png"
     whole = core | (read_image(extra, "L") > 127) if extra.is_file() else core

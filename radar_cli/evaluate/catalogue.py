@@ -69,8 +69,7 @@ def _reference_iou(folder: Path, material: dict, silhouettes: Path, object_id: s
     box = material.get("crop_box")
     if not (isinstance(box, list) and len(box) == 3):
         raise ValueError("material.json has no crop_box to place the reference silhouette")
-    x0, y0, side = (int(v) for v in box)
-    return reference_iou(drawn, reference, CropBox(x0, y0, side, float(material.get("crop_turn", 0.0))))
+    return reference_iou(drawn, reference, CropBox.from_record(material))
 
 
 def measure(folder: Path, object_id: str, view: str, size: ObjectSize, drawings: Path | None,

@@ -28,6 +28,16 @@ class CropBox:
     def to_list(self) -> list[int]:
         return [self.x0, self.y0, self.side]
 
+    def record(self) -> dict:
+        """material.json's entries for the window: `crop_box` [x0, y0, side] and, where turned, `crop_turn` (deg)."""
+        return {"crop_box": self.to_list(), **({"crop_turn": round(self.turn, 2)} if self.turn else {})}
+
+    @classmethod
+    def from_record(cls, record: dict) -> CropBox:
+        """The window of a material.json record (`record`'s entries)."""
+        x0, y0, side = (int(v) for v in record["crop_box"])
+        return cls(x0, y0, side, float(record.get("crop_turn", 0.0)))
+
 
 def mask_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
     """(x0, y0, x1, y1) half-open bounding box of a bool mask, or None if it is empty."""

@@ -82,8 +82,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
     record = state.record()
     record.update({
         "source": str(item.image_path),
-        "crop_box": prepared.crop.to_list(),
-        **({"crop_turn": round(prepared.crop.turn, 2)} if prepared.crop.turn else {}),
+        **prepared.crop.record(),
         "photo_size": list(prepared.photo_size),
         "backdrop": prepared.backdrop,
         "image_size": setup.render.image_size,
