@@ -11,6 +11,7 @@ import click
 
 from radar_cli import __version__
 from radar_cli.allocator import keep_freed_memory
+from radar_cli.blas_threads import single_threaded_blas
 from radar_cli.errors import RadarError
 
 # (command name, module, attribute, one-line help): one line per working subcommand, in pipeline order.
@@ -75,5 +76,6 @@ def cli() -> None:
 
 def main() -> None:
     """Console-script entry point."""
+    single_threaded_blas()  # before any command imports numpy
     keep_freed_memory()
     cli()
