@@ -136,19 +136,18 @@ def _axis_runs(mask: np.ndarray, axis: float) -> tuple[np.ndarray, np.ndarray]:
     return left, right
 
 
-def _top_spike(radius: np.ndarray, limit: np.ndarray, rows: np.ndarray) -> np.ndarray:
-    """`limit` (per-row half-width bound) with 0 on the rows above the rim narrower than SPIKE_WIDTH x its radius
-    (the widest row within SPIKE_SPAN of the top), if they span at least END_ROWS of the height and the rim
-    widens from them in one row by SHELF of its radius: a part standing on the rim (module docstring)."""
-    out = limit.copy()
+def _top_spike(radius: np.ndarray, rows: np.ndarray) -> int:
+    """How many rows at the top stand on the rim: the rows above it narrower than SPIKE_WIDTH x its radius (the
+    widest row within SPIKE_SPAN of the top), if they span at least END_ROWS of the height and the rim widens from
+    them in one row by SHELF of its radius (module docstring); 0 if none."""
     height = rows.max() - rows.min() + 1
     top, span = int(rows.min()), max(1, int(round(SPIKE_SPAN * height)))
     window = np.nan_to_num(radius[top : top + span], nan=0.0)
     spike = int(np.argmax(window >= SPIKE_WIDTH * window.max()))
     # shorter: the rim's own rounded top; no shelf (the width grows gradually): a domed top, the solid's own
     if spike >= END_ROWS * height and window[spike] - window[spike - 1] >= SHELF * window.max():
-        out[top : top + spike] = 0.0
-    return out
+        return spike
+    return 0
 
 
 def _outer_extents(mask: np.ndarray, axis: float) -> tuple[np.ndarray, np.ndarray]:
@@ -235,16 +234,17 @@ def _opening(profile: np.ndarray, span: int) -> np.ndarray:
     return cv2.dilate(eroded, kernel, borderType=cv2.BORDER_REPLICATE)[:, 0]
 
 
-def _keep_ends(radius: np.ndarray, opened: np.ndarray, tol: float, rows: np.ndarray) -> np.ndarray:
-    """The opened profile, except over bumps that start or end within `END_ROWS` of the first or last row: a
-    rim or a foot is the solid's own, a handle's attachment lies between body rows."""
+def _keep_ends(radius: np.ndarray, opened: np.ndarray, tol: float, rows: np.ndarray, top: int) -> np.ndarray:
+    """The opened profile, except over bumps that start or end within `END_ROWS` of the top (`top`: the first
+    row of the solid, under what stands on its rim) or the last row: a rim or a foot is the solid's own, a handle's
+    attachment lies between body rows."""
     out = opened.copy()
     bump = np.zeros(len(radius) + 2, np.int8)
     bump[1:-1] = np.nan_to_num(radius, nan=0.0) > opened + tol
     edges = np.diff(bump)
     near = END_ROWS * (rows.max() - rows.min() + 1)
     for start, end in zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]):
-        if start <= rows.min() + near or end >= rows.max() - near:
+        if start <= top + near or end >= rows.max() - near:
             out[start:end] = radius[start:end]
     return out
 
@@ -259,8 +259,9 @@ def upright_core(mask: np.ndarray, axis: float) -> np.ndarray:
     tol = SIDE_TOLERANCE * (cols.max() - cols.min() + 1)
     radius = np.fmin(left, right)
     opened = _opening(radius, int(round(BUMP_SPAN * (rows.max() - rows.min() + 1))))
-    limit = np.fmin(radius, _keep_ends(radius, opened, tol, rows)) + tol
-    limit = _top_spike(radius, limit, rows)
+    spike = _top_spike(radius, rows)  # what stands on the rim; the rim under it is the solid's top
+    limit = np.fmin(radius, _keep_ends(radius, opened, tol, rows, int(rows.min()) + spike)) + tol
+    limit[rows.min() : rows.min() + spike] = 0.0
     limit = _handle_plates(mask, axis, left, right, limit, rows, tol)
     xs = np.arange(mask.shape[1]) + 0.5 - (axis + 0.5)  # pixel centres relative to the axis
     core = np.zeros_like(mask)
