@@ -14,7 +14,8 @@ from radar_cli.fileio import image_errors, read_image
 from radar_cli.masks import crop as crops
 from radar_cli.masks.detect import Detection, detect
 from radar_cli.masks.quality import Thresholds, judge, score_mask
-from radar_cli.masks.refine import refine
+from radar_cli.masks.refine import main_component, refine
+from radar_cli.masks.scale_bar import find_scale_bar
 
 MIN_PHOTO_SIDE = 64  # photos whose long edge is shorter than this cannot give a useful crop ...
 MIN_PHOTO_SHORT = 16  # ... nor those whose short edge is (a slender vessel's thumbnail, 60 x 190 px, can)
@@ -156,6 +157,9 @@ def refine_detection(image: np.ndarray, found: Detection, settings: Settings) ->
     mask, used_grabcut = refine(work_img, rough, sure=sure, outside=outside)
     if not mask.any():
         mask = rough & ~outside if (rough & ~outside).any() else ~outside
+    bar = find_scale_bar(work_img, mask)  # a scale bar laid against the foot is no part of the vessel
+    if bar is not None and (mask & ~bar).any():
+        mask = main_component(mask & ~bar)
     return Refined(mask, window, outside, used_grabcut, work_img)
 
 
