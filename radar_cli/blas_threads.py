@@ -2,8 +2,8 @@
 
 radar runs its objects side by side (`--workers` threads, worker processes) and its numpy matrices are small
 (backdrop fits, least squares over a few hundred rows), so OpenBLAS's own threads (as numpy's wheels ship it) only
-spin on the cores the other workers need. 24 photos at 512 px on 2 cores, `radar derender` with 2 workers: 77 ->
-63 CPU s and 41 -> 36 s in the run, the same bytes (docs/performance.md).
+spin on the cores the other workers need. 24 photos at 512 px on 2 cores, `radar derender` with 2 workers: 76 ->
+64-66 CPU s and 41 -> 35 s in the run, the same bytes (docs/performance.md).
 """
 
 from __future__ import annotations

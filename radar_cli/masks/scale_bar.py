@@ -4,8 +4,8 @@ of the vessel.
 Documentation photographs often show a scale: a bar of equal black and white segments (centimetres) on the floor
 in front of the object. Apart from the object it is a neighbour like any other; touching or overlapping the foot,
 its black segments join the located object, draw a band under the foot and pull the axis off (22 photographs of
-../shared/data/cva10 and the Met with a bar touching the foot: a rim read 22 % narrow and a level jug read at
-13 deg, both `ok`; docs/real-photos.md). A bar is found row by row in the lowest part of the object: at least
+../shared/data/cva10 and the Met with a bar over the foot: a level jug read at 13 deg and `ok`, right views sent to
+`review`; docs/real-photos.md). A bar is found row by row in the lowest part of the object: at least
 MIN_SEGMENTS alternating near-black and near-white segments of even length, on at least MIN_ROWS rows that share
 their ends. Painted bands do not pass: their light parts are clay, slip or glaze, coloured or grey, not white, and
 the bar must reach below the object's lowest rows or stand in them.
@@ -13,6 +13,7 @@ the bar must reach below the object's lowest rows or stand in them.
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
 DARK = 0.3
@@ -27,7 +28,7 @@ MIN_SEGMENT_PX = 3
 """... each at least this long ..."""
 EVEN = 0.25
 """... and all but the two end ones (a frame or the object may cut them) within this share of their median length
-of it (at least 1.5 px)."""
+(or 1.5 px) of it."""
 MIN_ROWS = 3
 """A bar spans at least this many rows whose runs share their ends (within OVERLAP of their length)."""
 OVERLAP = 0.8
@@ -89,7 +90,7 @@ def find_scale_bar(image: np.ndarray, mask: np.ndarray) -> np.ndarray | None:
         return None
     top = int(rows[0] + (1.0 - LOWEST) * (rows[-1] - rows[0] + 1))
     pixels = image[top:].astype(np.int16)
-    luma = (pixels @ np.array([299, 587, 114])) / 255000.0
+    luma = cv2.cvtColor(np.ascontiguousarray(image[top:]), cv2.COLOR_RGB2GRAY) / 255.0
     white = (luma >= LIGHT) & (pixels.max(2) - pixels.min(2) <= NEUTRAL)
     labels = np.where(luma <= DARK, 1, np.where(white, 2, 0)).astype(np.int8)
     enough = MIN_SEGMENTS // 2 * MIN_SEGMENT_PX
