@@ -7,8 +7,9 @@ its black segments join the located object, draw a band under the foot and pull 
 ../shared/data/cva10 and the Met with a bar over the foot: a level jug read at 13 deg and `ok`, right views sent to
 `review`; docs/real-photos.md). A bar is found row by row in the lowest part of the object: at least
 MIN_SEGMENTS alternating near-black and near-white segments of even length, on at least MIN_ROWS rows that share
-their ends. Painted bands do not pass: their light parts are clay, slip or glaze, coloured or grey, not white, and
-the bar must reach below the object's lowest rows or stand in them.
+their ends, with no more of the object below them than the bar's own height (its blurred lower edge). Painted
+bands do not pass: their light parts are clay, slip or glaze, coloured or grey, and a black-and-white one on a
+white ground has the vessel's foot below it (unless the foot is thinner than the band: then it is cut as a bar).
 """
 
 from __future__ import annotations
@@ -77,7 +78,7 @@ def _row_bar(labels: np.ndarray) -> tuple[int, int] | None:
 
 
 def find_scale_bar(image: np.ndarray, mask: np.ndarray) -> np.ndarray | None:
-    """The pixels of a black-and-white scale bar that the located object touches in its lowest rows.
+    """The pixels of a black-and-white scale bar that the located object touches and ends with (its lowest rows).
 
     Args:
         image: n x n x 3 uint8, the window the object was located in. mask: n x n bool, the located object.
@@ -113,7 +114,8 @@ def find_scale_bar(image: np.ndarray, mask: np.ndarray) -> np.ndarray | None:
         pad = max(2, round(MARGIN * (y1 - y0 + 1)))
         bar = np.zeros(mask.shape, bool)
         bar[max(0, y0 - pad) : y1 + pad + 1, max(0, x0 - pad) : x1 + pad + 1] = True
-        if (bar & mask).any():
+        below = rows[-1] - y1  # the object's rows under the bar's: its own blurred edge, or a vessel's foot
+        if (bar & mask).any() and below <= max(3, y1 - y0 + 1):
             return bar
     return None
 
