@@ -67,20 +67,28 @@ SAMPLE_STEP = 8
 SAMPLE_MIN = 100_000
 """Discs x lines below which all are evaluated at once (the grouping and the sample cost more than they save)."""
 PRUNE_MARGIN = 1e-4
-"""A disc is left out only when its nearest point is this far (normalised units, 1/40 px at 512 px) beyond
-the sampled discs' end on every line it spans: far more than the crossings' rounding (~1e-8 at a tangent)."""
+"""A disc is left out of a run of lines only when its nearest point there is this far (normalised units, 1/40 px
+at 512 px) beyond the sampled discs' end on every line of the run: far more than the crossings' rounding (~1e-8
+at a tangent)."""
+PART_LINES = 8
+"""The lines a disc spans are tested for pruning in runs of this many: a wide ellipse (a disc seen from above, in
+the columns' pass) holds the ends only near its own extremes, and is left out of the runs between them."""
 
 
 def disc_winners(conic: tuple[torch.Tensor, ...], low: torch.Tensor, high: torch.Tensor,
-                 extent: tuple[torch.Tensor, torch.Tensor],
+                 extremes: tuple[tuple[torch.Tensor, torch.Tensor], tuple[torch.Tensor, torch.Tensor]],
                  lines: tuple[float, float, int]) -> tuple[torch.Tensor, torch.Tensor]:
     """Per line, the disc whose ellipse crosses it furthest left and furthest right (conic: the six B x K
-    coefficients as crossings takes them; low, high: B x K the ellipses' tangent heights; extent: B x K their
-    least and greatest x): (left, right) B x N disc indices, K where no ellipse crosses the line.
+    coefficients as crossings takes them; low, high: B x K the ellipses' tangent heights; extremes: their
+    leftmost and rightmost points, (x, y) B x K each): (left, right) B x N disc indices, K where no ellipse
+    crosses the line.
 
-    Each ellipse is evaluated only on the lines it spans, and only if it can win one: a sample of the discs is
-    evaluated first, and a disc whose least x lies beyond the sample's left end on every line it spans (and
-    whose greatest x short of the right end) cannot hold an end, nor tie one. No gradients."""
+    Each ellipse is evaluated only on the lines it spans, and only where it can win: a sample of the discs is
+    evaluated first, and on each run of PART_LINES lines a disc whose leftmost point there lies beyond the
+    sample's left end on every line of the run (and whose rightmost point short of the right end) cannot hold an
+    end there, nor tie one. An ellipse's left edge is convex in the line's height and its right edge concave, so
+    a run's leftmost point is the ellipse's own where that lies in the run's heights, else at one of the run's
+    ends: the bound is exact, and the winners are those of every disc on every line. No gradients."""
     y0, dy, n = lines
     batch, k = low.shape
     first, last = line_spans(low, high, lines)
@@ -97,38 +105,78 @@ def disc_winners(conic: tuple[torch.Tensor, ...], low: torch.Tensor, high: torch
     done = _evaluate(conic, first, last, sample.flatten(), lines)
     left = _line_best(done[0], done[2], done[3], batch, n, "amin")  # B x N, inf where no sampled disc crosses
     right = _line_best(done[1], done[2], done[3], batch, n, "amax")
-    beyond = (extent[0] > _range_reduce(left, first, last, torch.maximum) + PRUNE_MARGIN) & (
-        extent[1] < _range_reduce(right, first, last, torch.minimum) - PRUNE_MARGIN)
-    more = _evaluate(conic, first, last, (spans & ~sample & ~beyond).flatten(), lines)
+    parts = max(-(-int((last - first).max() + 1) // PART_LINES), 1)
+    part_first = first[..., None] + PART_LINES * torch.arange(parts, device=first.device)  # B x K x P
+    part_last = torch.minimum(part_first + PART_LINES - 1, last[..., None])
+    nearest = _run_extremes(conic, low, high, extremes, part_first, part_last, lines)
+    flat_first, flat_last = part_first.flatten(1), part_last.flatten(1)  # B x KP
+    beyond = (nearest[0].flatten(1) > _range_reduce(left, flat_first, flat_last, torch.maximum) + PRUNE_MARGIN) & (
+        nearest[1].flatten(1) < _range_reduce(right, flat_first, flat_last, torch.minimum) - PRUNE_MARGIN)
+    chosen = ((spans & ~sample)[..., None] & (part_first <= part_last)).flatten(1) & ~beyond
+    more = _evaluate(conic, flat_first, flat_last, chosen.flatten(), lines, parts)
     lo, hi, target, inside, disc = (torch.cat([a, b]) for a, b in zip(done, more))
     return (winner(lo, target, inside, disc, batch, n, "amin", k),
             winner(hi, target, inside, disc, batch, n, "amax", k))
 
 
+def _run_extremes(conic: tuple[torch.Tensor, ...], low: torch.Tensor, high: torch.Tensor,
+                  extremes: tuple[tuple[torch.Tensor, torch.Tensor], tuple[torch.Tensor, torch.Tensor]],
+                  part_first: torch.Tensor, part_last: torch.Tensor,
+                  lines: tuple[float, float, int]) -> tuple[torch.Tensor, torch.Tensor]:
+    """The leftmost and rightmost x of each ellipse (B x K, as disc_winners) over the heights of each run of lines
+    (B x K x P, first .. last) clamped to its span [low, high]; -inf and inf (never pruned) for conics that are no
+    ellipse. B x K x P each."""
+    y0, dy, _ = lines
+    ends = [y0 + i.to(low.dtype) * dy for i in (part_first, part_last)]
+    bottom = torch.maximum(torch.minimum(*ends), low[..., None]).clamp(max=high[..., None])
+    top = torch.minimum(torch.maximum(*ends), high[..., None]).clamp(min=low[..., None])
+    q00, q01, q02, q11, q12, q22 = (c[..., None] for c in conic)
+    edges = []
+    for h in (bottom, top):  # both edges at the run's ends: the crossings, the discriminant clamped at a tangent
+        qb = q01 * h + q02
+        root = torch.sqrt((qb * qb - q00 * (q11 * h * h + 2 * q12 * h + q22)).clamp_min(0.0))
+        t1, t2 = (-qb - root) / q00, (-qb + root) / q00
+        edges.append((torch.minimum(t1, t2), torch.maximum(t1, t2)))
+    ellipse = q00 * q11 - q01 * q01 > 0
+    bounds = []
+    for i, ((x, y), reduce, far) in enumerate(zip(extremes, (torch.minimum, torch.maximum), (-math.inf, math.inf))):
+        x, y = x[..., None], y[..., None]
+        inside = (y >= bottom) & (y <= top)
+        bound = torch.where(inside, x, reduce(edges[0][i], edges[1][i]))
+        known = ellipse & x.isfinite() & y.isfinite() & bound.isfinite()
+        bounds.append(torch.where(known, bound, torch.full_like(bound, far)))
+    return bounds[0], bounds[1]
+
+
 def _evaluate(conic: tuple[torch.Tensor, ...], first: torch.Tensor, last: torch.Tensor, chosen: torch.Tensor,
-              lines: tuple[float, float, int]) -> tuple[torch.Tensor, ...]:
-    """The crossings of the chosen discs (flat B K bool) with the lines first .. last each spans (B x K), in
-    BAND_GROUPS groups of similar widths: flat (lo, hi, b (N + 1) + line, on a line, disc index)."""
+              lines: tuple[float, float, int], parts: int = 1) -> tuple[torch.Tensor, ...]:
+    """The crossings of the chosen discs' runs of lines (flat B x KP bool; `parts` runs per disc, first .. last
+    each, B x KP), in BAND_GROUPS groups of similar widths: flat (lo, hi, b (N + 1) + line, on a line, disc
+    index)."""
     y0, dy, n = lines
-    k = first.shape[1]
+    runs = first.shape[1]
     first, last = first.flatten(), last.flatten()
     count = last - first + 1
     order = torch.nonzero(chosen).flatten()
     order = order[torch.argsort(count[order], stable=True)]
-    parts: list[list[torch.Tensor]] = [[], [], [], [], []]
+    coefficients = tuple(c.flatten() for c in conic)
+    out: list[list[torch.Tensor]] = [[], [], [], [], []]
     for group in torch.tensor_split(order, BAND_GROUPS) if len(order) else ():
         if not len(group):
             continue
         index = first[group, None] + torch.arange(int(count[group].max()), device=first.device)  # G x W
         inside = index <= last[group, None]
         index = torch.where(inside, index, torch.full_like(index, n))
-        crossing = crossings(tuple(c.flatten()[group, None] for c in conic), y0 + index.to(conic[0].dtype) * dy)
-        for i, t in enumerate((*crossing, index + (group // k)[:, None] * (n + 1), inside, (group % k)[:, None])):
-            parts[i].append(t.expand_as(index).flatten())
+        b, run = group // runs, group % runs
+        disc = run // parts
+        at = (b * (runs // parts) + disc)[:, None]
+        crossing = crossings(tuple(c[at] for c in coefficients), y0 + index.to(conic[0].dtype) * dy)
+        for i, t in enumerate((*crossing, index + b[:, None] * (n + 1), inside, disc[:, None])):
+            out[i].append(t.expand_as(index).flatten())
     empty = (torch.zeros(0, dtype=conic[0].dtype, device=first.device),) * 2 + (
         torch.zeros(0, dtype=torch.long, device=first.device), torch.zeros(0, dtype=torch.bool, device=first.device),
         torch.zeros(0, dtype=torch.long, device=first.device))
-    return tuple(torch.cat(p) if p else e for p, e in zip(parts, empty))
+    return tuple(torch.cat(p) if p else e for p, e in zip(out, empty))
 
 
 def _line_best(values: torch.Tensor, target: torch.Tensor, inside: torch.Tensor, batch: int, n: int,

@@ -163,7 +163,7 @@ def _row_ends(q: torch.Tensor, lines: tuple[float, float, int]) -> tuple[torch.T
     sides = ((xa, a * xa + b), (xb, a * xb + b))
     y0, dy, n = lines
     with torch.no_grad():
-        discs = disc_winners(conic, *_tangent_heights(_adjugate(q)), (xa, xb), lines)  # (left, right), B x N
+        discs = disc_winners(conic, *_tangent_heights(_adjugate(q)), sides, lines)  # (left, right), B x N
         segments = []
         for i, (x, ys) in enumerate(sides):
             seg_index, at = band(*line_spans(ys[:, :-1], ys[:, 1:], lines), lines)  # B x (K-1) x W

@@ -108,3 +108,31 @@ def test_sampled_and_grouped_discs_give_the_dense_outline_bit_for_bit(size, monk
     for a, b in zip(grouped, dense):
         assert torch.equal(torch.nan_to_num(a, nan=-7.0), torch.nan_to_num(b, nan=-7.0))
     assert grouped[0].isfinite().sum() > 4 * 6 * size // 4  # the solids cover a good part of every image
+
+
+def test_wide_ellipses_are_left_out_between_their_extremes_and_the_winners_stay(monkeypatch):
+    """Seen from well above, each disc's ellipse spans most columns, but holds a column's top or bottom only near
+    its own extremes: the runs between are pruned (far fewer crossings evaluated than the discs' full spans) and
+    every column's winner is the one of every disc on every column."""
+    evaluated = []
+    evaluate = conic_lines._evaluate
+
+    def counting(*args):
+        found = evaluate(*args)
+        evaluated.append(int(found[3].sum()))
+        return found
+
+    radius, height, pose = _vase(35.0, 3.0, 0.02, -0.03)
+    solid = Solid(radius.double(), height.double(), pose.double())
+    monkeypatch.setattr(conic_lines, "_evaluate", counting)
+    monkeypatch.setattr(conic_lines, "SAMPLE_MIN", 0)
+    pruned = outline(solid, 384, CameraConfig())
+    monkeypatch.setattr(conic_lines, "PART_LINES", 10**6)  # one run per disc: the disc's whole span
+    whole = outline(solid, 384, CameraConfig())
+    monkeypatch.setattr(conic_lines, "SAMPLE_MIN", 10**12)  # every disc on every line it spans
+    dense = outline(solid, 384, CameraConfig())
+    for name in ("left", "right", "top", "bottom"):
+        a, b, c = (torch.nan_to_num(getattr(o, name), nan=-7.0) for o in (pruned, whole, dense))
+        assert torch.equal(a, c) and torch.equal(b, c), name
+    # the rows' and the columns' passes, each a sample then the rest: the columns' rest is where runs count
+    assert evaluated[3] < 0.25 * evaluated[7]
