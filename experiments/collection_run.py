@@ -4,9 +4,11 @@ memory sampled every few seconds into a CSV and drawn as a PNG (docs/performance
     python -m experiments.collection_run OUT [--photos 1000] [--every 3] [--limit-s 0] [-- DERENDER OPTIONS...]
 
 OUT/photos/ holds the collection (each example at 819 px, 1.6 x the 512 px output as `radar bench derender` draws
-them, cycled, every other cycle mirrored), OUT/results/ the run's results, OUT/rss.csv (seconds, RSS of the
-`radar derender` process in MiB, objects finished) and OUT/rss.png. --limit-s stops the run (SIGINT) after that
-many seconds, for a machine that cannot finish it; 0 runs it to the end.
+them, cycled, every other cycle mirrored), OUT/results/ the run's results, OUT/rss.csv (seconds; the resident and
+the proportional set size, RSS and PSS, of the `radar derender` process and its worker processes together, in
+MiB; objects finished) and OUT/rss.png. RSS counts the pages the processes share (torch's libraries) once per
+process, PSS shares them out: PSS is the memory the run takes from the machine. --limit-s stops the run (SIGINT)
+after that many seconds, for a machine that cannot finish it; 0 runs it to the end.
 """
 
 from __future__ import annotations
@@ -37,14 +39,29 @@ def tile_examples(out: Path, n: int) -> None:
         image.save(out / f"photo_{k:04d}.jpg", quality=92)
 
 
-def _rss_mib(pid: int) -> float | None:
+def _tree(pid: int) -> list[int]:
+    """pid and its descendants (Linux /proc)."""
     try:
-        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) / 1024
+        children = Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
     except OSError:
-        return None
-    return None
+        return [pid]
+    return [pid] + [p for child in children for p in _tree(int(child))]
+
+
+def _memory_mib(pid: int) -> tuple[float, float] | None:
+    """(RSS, PSS) in MiB of pid and its descendants together, None when it has ended."""
+    rss = pss = 0
+    for p in _tree(pid):
+        try:
+            for line in Path(f"/proc/{p}/smaps_rollup").read_text().splitlines():
+                if line.startswith("Rss:"):
+                    rss += int(line.split()[1])
+                elif line.startswith("Pss:"):
+                    pss += int(line.split()[1])
+        except OSError:
+            if p == pid:
+                return None
+    return rss / 1024, pss / 1024
 
 
 def run(photos: Path, results: Path, table: Path, every: float, limit_s: float, options: list[str]) -> int:
@@ -54,12 +71,13 @@ def run(photos: Path, results: Path, table: Path, every: float, limit_s: float, 
     proc = subprocess.Popen(cmd)
     with open(table, "w", newline="") as f:
         writer = csv.writer(f)
-        writer.writerow(("t_s", "rss_mib", "objects_done"))
+        writer.writerow(("t_s", "rss_mib", "pss_mib", "objects_done"))
         while proc.poll() is None:
-            rss = _rss_mib(proc.pid)
+            memory = _memory_mib(proc.pid)
             elapsed = time.monotonic() - start
-            if rss is not None:
-                writer.writerow((round(elapsed, 1), round(rss, 1), len(list(results.glob("*/material.json")))))
+            if memory is not None:
+                writer.writerow((round(elapsed, 1), round(memory[0], 1), round(memory[1], 1),
+                                 len(list(results.glob("*/material.json")))))
                 f.flush()
             if limit_s and elapsed > limit_s:
                 proc.send_signal(signal.SIGINT)
@@ -71,9 +89,9 @@ def run(photos: Path, results: Path, table: Path, every: float, limit_s: float, 
 
 
 def plot(table: Path, out: Path) -> None:
-    """RSS (blue, MiB on the left) and objects finished (grey, on the right) against time."""
-    rows = [(float(r[0]), float(r[1]), int(r[2])) for r in list(csv.reader(open(table)))[1:]]
-    t, rss, done = zip(*rows) if rows else ((0.0,), (0.0,), (0,))
+    """RSS (light blue) and PSS (blue), MiB on the left, and objects finished (grey, on the right) against time."""
+    rows = [(float(r[0]), float(r[1]), float(r[2]), int(r[3])) for r in list(csv.reader(open(table)))[1:]]
+    t, rss, pss, done = zip(*rows) if rows else ((0.0,), (0.0,), (0.0,), (0,))
     width, height, left, bottom, top, right = 900, 420, 70, 50, 30, 70
     image = Image.new("RGB", (width, height), "white")
     draw = ImageDraw.Draw(image)
@@ -88,9 +106,10 @@ def plot(table: Path, out: Path) -> None:
     for k in (0, d_max // 2, d_max):
         draw.text((width - right + 6, y(k, d_max) - 6), str(k), fill="gray")
     draw.line([(x(a), y(b, d_max)) for a, b in zip(t, done)], fill="gray", width=2)
-    draw.line([(x(a), y(b, r_max)) for a, b in zip(t, rss)], fill="blue", width=2)
-    draw.text((left, 8), "radar derender: resident memory (blue, left axis) and objects finished (grey, right)",
-              fill="black")
+    draw.line([(x(a), y(b, r_max)) for a, b in zip(t, rss)], fill="lightblue", width=2)
+    draw.line([(x(a), y(b, r_max)) for a, b in zip(t, pss)], fill="blue", width=2)
+    draw.text((left, 8), "radar derender and its workers: memory, RSS (light blue) and PSS (blue), left axis; "
+              "objects finished (grey, right)", fill="black")
     image.save(out)
 
 

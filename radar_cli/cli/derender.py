@@ -79,7 +79,8 @@ RESOLUTION = ResolutionType()
 @click.option("--batch-size", type=click.IntRange(1, 1024), default=8, show_default=True,
               help="Images per network batch.")
 @click.option("--workers", type=click.IntRange(0, 64), default=2, show_default=True,
-              help="Threads reading and cropping images, and exporting objects.")
+              help="Objects de-rendered at a time: processes where the model runs on the CPU (each holds its own "
+                   "copy, about 0.7 GB at 512 px), threads beside a GPU.")
 @click.option("--threads", type=click.IntRange(1, 256), default=1, show_default=True,
               help="torch threads for the network (more helps only on an otherwise idle machine).")
 @click.option("--overwrite", is_flag=True, help="Redo objects whose folders are already complete.")
@@ -108,7 +109,7 @@ def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks
     options = DerenderOptions(out=out, crop=crop, backdrop=backdrop, masks=masks,  # type: ignore[arg-type]
                               envs=envs, batch_size=batch_size, workers=workers, threads=threads, overwrite=overwrite,
                               export=ExportConfig(views, view_size), resolution=resolution, shard=Shard.parse(shard),
-                              dimensions=dimensions)
+                              dimensions=dimensions, processes=True)
     summary = derender_sharded(list(inputs), load, options, device, say=lambda line: click.echo(line, err=True))
     if contact_sheet is not None and summary.index is not None and (summary.done or summary.skipped):
         click.echo(f"contact sheet: {write_contact_sheet(out, contact_sheet)}")

@@ -4,10 +4,16 @@ One bad input costs one line and one failures.csv row; the rest are processed. F
 skipped (a killed run resumes) and never overwritten without `overwrite`. An object's files are the same bytes
 whatever the batch size, worker count or share and wherever a killed run resumed: the network sees one photo at a
 time (Predictor.predict) and each object is refined and exported on one torch thread (EXPORT_THREADS).
+
+Workers are processes where the model runs on the CPU (`DerenderOptions.processes`, run.processes: each object
+one task, taken by whichever process is free) and threads beside a GPU, which one process drives.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+import pickle
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -17,6 +23,7 @@ from typing import Callable, TypeVar
 import numpy as np
 from tqdm import tqdm
 
+from radar_cli.allocator import keep_freed_memory
 from radar_cli.derender.export.environments import builtin_environments, env_name, load_environment
 from radar_cli.derender.export.object_folder import ExportConfig, export_object, is_complete
 from radar_cli.derender.multiview.driver import derender_views, recorded_left_out
@@ -35,6 +42,7 @@ from radar_cli.derender.run.inputs import (
 )
 from radar_cli.derender.run.object_size import SizeFinder
 from radar_cli.derender.run.predictor import Predictor
+from radar_cli.derender.run.processes import spread
 from radar_cli.derender.run.shard import Shard, read_share_failures, write_share_failures
 from radar_cli.derender.run.upsample import full_resolution_state
 from radar_cli.errors import InputError, NothingToDoError, RadarError
@@ -73,6 +81,9 @@ class DerenderOptions:
     """The share of the inputs this process de-renders (0/1: all of them)."""
     dimensions: Path | None = None
     """A table of catalogued sizes (radar_cli.sizes.read_size_table); harvested sizes are used without it."""
+    processes: bool = False
+    """Workers as processes, each object a task, where the model runs on the CPU (the CLI's choice; on two
+    cores 24 photos took 27 s where two threads took 35 s, docs/performance.md); threads otherwise."""
 
 
 @dataclass
@@ -191,17 +202,10 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
     several = [block[0] for block in shard.blocks([i for i in items if i.multiview], 1)]
     with sizes, torch_threads(options.threads), tqdm(total=sum(map(len, batches)) + len(several), desc="derender",
                                                      unit="obj", disable=None) as bar:
-        runner = _Batches(predictor, options, envs, summary, say, sizes, bar)
-        try:
-            for batch in batches:
-                runner.run(batch, _pending(batch, options.out, options.overwrite, summary, say))
-            runner.finish()
-        finally:
-            runner.pool.close()
-        for item in several:
-            if _pending([item], options.out, options.overwrite, summary, say):
-                _run_views(item, predictor, options, envs, summary, say, sizes)
-            bar.update(1)
+        if options.processes and options.workers > 1 and predictor.device.type == "cpu":
+            _on_processes(batches, several, predictor, options, envs, summary, say, sizes, bar)
+        else:
+            _on_threads(batches, several, predictor, options, envs, summary, say, sizes, bar)
     if shard.enabled:
         write_share_failures(options.out, shard, summary.failures)
     if report:
@@ -211,6 +215,100 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
     return summary
 
 
+def _on_threads(batches: list[list[InputItem]], several: list[InputItem], predictor: Predictor,
+                options: DerenderOptions, envs: dict[str, np.ndarray], summary: BatchSummary,
+                say: Callable[[str], None], sizes: SizeFinder, bar: tqdm) -> None:
+    """The batches through one pool of options.workers threads, then the multi-view objects one by one."""
+    runner = _Batches(predictor, options, envs, summary, say, sizes, bar)
+    try:
+        for batch in batches:
+            runner.run(batch, _pending(batch, options.out, options.overwrite, summary, say))
+        runner.finish()
+    finally:
+        runner.pool.close()
+    for item in several:
+        if _pending([item], options.out, options.overwrite, summary, say):
+            _run_views(item, predictor, options, envs, summary, say, sizes)
+        bar.update(1)
+
+
+@dataclass(frozen=True)
+class _Task:
+    """One object for a worker process: a photo, or a multi-view object's folder (views)."""
+
+    item: InputItem
+    views: bool = False
+
+
+@dataclass
+class _Outcome:
+    """What a worker process did with a _Task: the object done, or its failures, and the lines it said."""
+
+    done: list[str]
+    failures: list[Failure]
+    said: list[str]
+
+
+def _on_processes(batches: list[list[InputItem]], several: list[InputItem], predictor: Predictor,
+                  options: DerenderOptions, envs: dict[str, np.ndarray], summary: BatchSummary,
+                  say: Callable[[str], None], sizes: SizeFinder, bar: tqdm) -> None:
+    """Every object still to do as a task for options.workers processes (this one and workers - 1 spawned ones,
+    each given the model and options pickled); outcomes recorded in input order, said as they come."""
+    tasks = []
+    for batch in batches:
+        todo = _pending(batch, options.out, options.overwrite, summary, say)
+        tasks += [_Task(item) for item in batch if item.name in todo]
+        bar.update(len(batch) - len(todo))
+    for item in several:
+        if _pending([item], options.out, options.overwrite, summary, say):
+            tasks.append(_Task(item, views=True))
+        else:
+            bar.update(1)
+    one = dataclasses.replace(options, workers=1)
+
+    def arrived(outcome: _Outcome) -> None:
+        for line in outcome.said:
+            say(line)
+        bar.update(1)
+
+    def lost(task: _Task, reason: str) -> _Outcome:
+        failure = Failure(str(task.item.image_path.parent if task.views else task.item.image_path),
+                          f"not de-rendered: {reason}")
+        return _Outcome([], [failure], [failure.line()])
+
+    payload = pickle.dumps((predictor, one, envs))
+    outcomes = spread(tasks, functools.partial(_run_task, predictor=predictor, options=one, envs=envs, sizes=sizes),
+                      functools.partial(_process_worker, payload), options.workers - 1, arrived, lost)
+    for outcome in outcomes:
+        summary.done += outcome.done
+        summary.failures += outcome.failures
+
+
+def _process_worker(payload: bytes) -> Callable[[_Task], _Outcome]:
+    """In a spawned worker process: the model, options and environments unpickled, the run's settings made (the
+    allocator's, torch's threads), and the task runner over them."""
+    keep_freed_memory()
+    predictor, options, envs = pickle.loads(payload)
+    import torch
+
+    torch.set_num_threads(options.threads)
+    sizes = SizeFinder(options.dimensions)  # open for the process's life: its catalogs' connections are its own
+    return functools.partial(_run_task, predictor=predictor, options=options, envs=envs, sizes=sizes)
+
+
+def _run_task(task: _Task, predictor: Predictor, options: DerenderOptions, envs: dict[str, np.ndarray],
+              sizes: SizeFinder) -> _Outcome:
+    """De-render one object in this process (options.workers 1)."""
+    summary, said = BatchSummary(), list[str]()
+    if task.views:
+        _run_views(task.item, predictor, options, envs, summary, said.append, sizes)
+    else:
+        runner = _Batches(predictor, options, envs, summary, said.append, sizes, None)
+        runner.run([task.item], {task.item.name})
+        runner.finish()
+    return _Outcome(summary.done, summary.failures, said)
+
+
 class _Batches:
     """Crops, predicts and exports the batches through one pool of options.workers threads, with no barrier
     between batches: a batch's photos are read and located while the batch before it is still exported, and the
@@ -218,7 +316,7 @@ class _Batches:
     first; each object's files are the same bytes as a one-worker run's (every export on one torch thread)."""
 
     def __init__(self, predictor: Predictor, options: DerenderOptions, envs: dict[str, np.ndarray],
-                 summary: BatchSummary, say: Callable[[str], None], sizes: SizeFinder, bar: tqdm):
+                 summary: BatchSummary, say: Callable[[str], None], sizes: SizeFinder, bar: tqdm | None):
         self.predictor, self.options, self.envs, self.summary, self.say = predictor, options, envs, summary, say
         self.sizes, self.bar = sizes, bar
         self.pool = _Pool(options.workers)
@@ -254,7 +352,8 @@ class _Batches:
             else:
                 self.summary.failures.append(failure)
                 self.say(failure.line())
-        self.bar.update(self.size_of_exporting)
+        if self.bar is not None:
+            self.bar.update(self.size_of_exporting)
         self.exporting, self.size_of_exporting = [], 0
 
     def _export_one(self, item: InputItem, prep: Prepared, dec: Decomposition,

@@ -166,7 +166,7 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         # one object at a time first, so its peak memory is not the parallel run's
         cost = _export_cost(predictor, Path(tmp) / "in", Path(tmp) / "one", resolution, export)
         options = DerenderOptions(out=Path(tmp) / "out", batch_size=batch_size, workers=workers, threads=threads,
-                                  export=export, resolution=resolution)
+                                  export=export, resolution=resolution, processes=True)
         start = time.perf_counter()
         summary = derender([Path(tmp) / "in"], predictor, options, say=lambda line: None)
         full = time.perf_counter() - start
