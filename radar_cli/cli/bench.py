@@ -91,12 +91,14 @@ def synth(size: int, n: int, workers: int, shading_size: int) -> None:
 @click.option("--images", default=32, show_default=True, type=click.IntRange(min=1),
               help="Images through the network alone.")
 @click.option("--exports", default=4, show_default=True, type=click.IntRange(min=1),
-              help="Images de-rendered end to end with every export.")
+              help="Images exported one at a time, for the seconds and memory per object.")
+@click.option("--full", "n_full", default=24, show_default=True, type=click.IntRange(min=1),
+              help="Photos de-rendered end to end by `radar derender` (the exported ones cycled).")
 @click.option("--batch-size", default=8, show_default=True, type=click.IntRange(min=1),
               help="Images per network batch (radar derender --batch-size).")
 @click.option("--threads", default=1, show_default=True, type=click.IntRange(min=1), help="torch threads.")
 @click.option("--workers", default=2, show_default=True, type=click.IntRange(min=0),
-              help="Threads cropping and exporting objects (radar derender --workers).")
+              help="Objects de-rendered at a time in the full run (radar derender --workers).")
 @click.option("--albedo", type=click.Choice(["network", "divided"]), default="divided", show_default=True,
               help="radar derender --albedo.")
 @click.option("--pitch", type=click.Choice(["network", "search"]), default="network", show_default=True,
@@ -105,13 +107,13 @@ def synth(size: int, n: int, workers: int, shading_size: int) -> None:
               help="radar derender --resolution (the benchmark's photos are 1.6 x this side).")
 @click.option("--refine", type=click.Choice(REFINE_MODES), default="full", show_default=True,
               help="radar derender --refine.")
-def derender(checkpoint: str | None, device: str, images: int, exports: int, batch_size: int, threads: int,
-             workers: int, albedo: str, pitch: str, resolution: Resolution, refine: str) -> None:
+def derender(checkpoint: str | None, device: str, images: int, exports: int, n_full: int, batch_size: int,
+             threads: int, workers: int, albedo: str, pitch: str, resolution: Resolution, refine: str) -> None:
     """Images per second for the network alone and for the full de-rendering with all exports; seconds per
     object and peak memory of the export at the output resolution."""
     from radar_cli.derender.run.benchmark import bench_derender
 
     click.echo(json.dumps(bench_derender(checkpoint, device, images, exports, batch_size, threads, workers=workers,
                                          albedo=albedo, pitch=pitch, resolution=resolution,  # type: ignore[arg-type]
-                                         refine=refine),  # type: ignore[arg-type]
+                                         refine=refine, n_full=n_full),  # type: ignore[arg-type]
                           indent=2))

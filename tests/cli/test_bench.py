@@ -36,11 +36,12 @@ def test_bench_masks_and_derender_print_json():
     report = json.loads(result.output)
     assert report["photos"] == 1 and report["photos_per_second"] > 0
     result = CliRunner().invoke(cli, ["bench", "derender", "--images", "2", "--exports", "1", "--batch-size", "2",
-                                      "--resolution", "96"])
+                                      "--resolution", "96", "--full", "3"])
     assert result.exit_code == 0, result.output
     report = json.loads(result.output)
     assert report["network_images_per_s"] > 0 and report["full_images_per_s"] > 0 and report["failed"] == 0
     assert report["resolution"] == [96] and report["export_seconds_per_object"] > 0 and report["peak_rss_mib"] > 0
+    assert report["n_full"] == 3 and report["full_peak_pss_mib"] > 0
 
 
 @pytest.mark.slow

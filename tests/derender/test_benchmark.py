@@ -8,7 +8,7 @@ from radar_cli.derender.run.benchmark import bench_derender
 
 def test_bench_derender_reports_rates(predictor) -> None:
     result = bench_derender(n_images=4, n_export=1, batch_size=2, export=ExportConfig(2, 32), predictor=predictor,
-                            resolution=64)
+                            resolution=64, n_full=3, workers=1)
     assert result["network_images_per_s"] > 0 and result["full_images_per_s"] > 0
     assert result["failed"] == 0 and result["image_size"] == 64 and result["model"] == "fake-model"
     assert result["albedo"] == "divided" and result["pitch"] == "network"
@@ -16,3 +16,4 @@ def test_bench_derender_reports_rates(predictor) -> None:
     assert 0 <= result["export_state_seconds"] <= result["export_seconds_per_object"]
     assert result["export_write_seconds"] > 0
     assert result["peak_rss_mib"] >= result["rss_before_export_mib"] > 0
+    assert result["n_full"] == 3 and result["full_peak_rss_mib"] >= result["full_peak_pss_mib"] > 0

@@ -3,9 +3,11 @@ export, and the seconds and memory of one object's export at the output resoluti
 
 from __future__ import annotations
 
+import os
 import resource
 import statistics
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -37,6 +39,61 @@ def _rss_mib() -> float:
 def _peak_rss_mib() -> float:
     """This process's peak resident memory so far, MiB (ru_maxrss is KiB on Linux)."""
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def _tree(pid: int) -> list[int]:
+    """pid and its descendants (Linux /proc; just pid elsewhere)."""
+    try:
+        children = Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
+    except OSError:
+        return [pid]
+    return [pid] + [p for child in children for p in _tree(int(child))]
+
+
+def _proc_kib(path: str, key: str) -> int:
+    """The KiB figure after `key` in a /proc file (0 where there is none)."""
+    try:
+        for line in Path(path).read_text().splitlines():
+            if line.startswith(key):
+                return int(line.split()[1])
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0
+
+
+class _PeakMemory:
+    """The memory of this process and its workers together while the block runs: `rss`, the sum of each
+    process's own peak resident set (the kernel's VmHWM, read every RSS_S: no peak is missed, and the sum bounds
+    the processes' peak together from above), and `pss`, the peak of their proportional set sizes summed (read
+    every PSS_S: smaps_rollup walks a process's whole memory map, too costly to read often), MiB."""
+
+    RSS_S, PSS_S = 0.1, 1.0
+
+    def __enter__(self) -> "_PeakMemory":
+        self.hwm: dict[int, int] = {}
+        self.pss = 0.0
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self._sample, daemon=True)
+        self.thread.start()
+        return self
+
+    def _sample(self) -> None:
+        last_pss = 0.0
+        while not self.stop.wait(self.RSS_S):
+            pids = _tree(os.getpid())
+            for pid in pids:
+                self.hwm[pid] = max(self.hwm.get(pid, 0), _proc_kib(f"/proc/{pid}/status", "VmHWM:"))
+            if time.monotonic() - last_pss >= self.PSS_S:
+                last_pss = time.monotonic()
+                self.pss = max(self.pss, sum(_proc_kib(f"/proc/{pid}/smaps_rollup", "Pss:") for pid in pids) / 1024)
+
+    @property
+    def rss(self) -> float:
+        return sum(self.hwm.values()) / 1024
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop.set()
+        self.thread.join()
 
 
 def _photos(n: int, size: int, seed: int = 0) -> list[np.ndarray]:
@@ -125,34 +182,36 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
                    export: ExportConfig = ExportConfig(), predictor: Predictor | None = None,
                    workers: int = 2, albedo: AlbedoSource = "divided",
                    pitch: PitchSource = "network", resolution: Resolution = DEFAULT_RESOLUTION,
-                   refine: RefineMode = "full") -> dict:
+                   refine: RefineMode = "full", n_full: int = 24) -> dict:
     """Measure de-rendering speed.
 
     Args:
         checkpoint: model weights (default: the bundled model).
         device: auto, cpu, cuda.
         n_images: images pushed through the network alone (at its side S).
-        n_export: images de-rendered end to end (read, crop, network, all exports, report), and then exported
-            one by one for the per-object figures; their photos are PHOTO_MARGIN x the output side.
+        n_export: images exported one by one for the per-object figures; their photos are PHOTO_MARGIN x the
+            output side.
         batch_size: network batch size.
         threads: torch intra-op threads.
         export: turntable and view settings of the full run.
         predictor: use this instead of loading `checkpoint` (tests).
-        workers: threads cropping and exporting objects.
+        workers: radar derender --workers (processes on the CPU, threads beside a GPU).
         albedo: the predictor's albedo source (`divided` adds the shading division to the network's time).
         pitch: the predictor's pitch source (`search` adds the pitch search).
         resolution: radar derender --resolution.
         refine: radar derender --refine (timed apart from the export, one object at a time).
+        n_full: photos de-rendered end to end by `radar derender` (read, crop, network, every export, report): the
+            n_export photos cycled. Enough of them that the workers' start is a small part of the run.
 
     Returns:
         {"network_images_per_s", "network_images_per_cpu_s", "full_images_per_s", "full_seconds_per_image",
          "resolution", "refine", "refine_seconds_per_object", "refine_cpu_seconds_per_object",
          "export_state_seconds", "export_write_seconds", "export_seconds_per_object",
          "export_cpu_seconds_per_object" (process CPU time: steadier than wall time on a shared machine),
-         "rss_before_export_mib", "peak_rss_mib" (after the one-at-a-time exports), "full_peak_rss_mib" (after the
-         full run with `workers` threads), "image_size", "photo_side", "batch_size", "n_images",
-         "n_export", "device", "threads", "workers", "albedo", "pitch", "model"}; the export figures are medians
-        over the objects.
+         "rss_before_export_mib", "peak_rss_mib" (after the one-at-a-time exports), "full_peak_rss_mib" and
+         "full_peak_pss_mib" (the full run's processes together, _PeakMemory), "image_size", "photo_side",
+         "batch_size", "n_images", "n_export", "n_full", "device", "threads", "workers", "albedo", "pitch",
+         "model"}; the export figures are medians over the objects.
     """
     predictor = predictor or Predictor.from_checkpoint(checkpoint, device, albedo, pitch, refine)
     size = predictor.setup.render.image_size
@@ -161,14 +220,18 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         net_wall, net_cpu = _network_rate(predictor, images, batch_size)
     photo_side = max(size, round(PHOTO_MARGIN * output_side(resolution, 1 << 30)))
     with tempfile.TemporaryDirectory(prefix="radar-bench-") as tmp:
-        for i, image in enumerate(_photos(n_export, photo_side)):
+        photos = _photos(max(n_export, n_full), photo_side)
+        for i, image in enumerate(photos[:n_export]):
             write_image(Path(tmp) / "in" / f"bench_{i:03d}.png", image)
+        for i, image in enumerate(photos[:n_full]):
+            write_image(Path(tmp) / "full" / f"bench_{i:03d}.png", image)
         # one object at a time first, so its peak memory is not the parallel run's
         cost = _export_cost(predictor, Path(tmp) / "in", Path(tmp) / "one", resolution, export)
         options = DerenderOptions(out=Path(tmp) / "out", batch_size=batch_size, workers=workers, threads=threads,
                                   export=export, resolution=resolution, processes=True)
         start = time.perf_counter()
-        summary = derender([Path(tmp) / "in"], predictor, options, say=lambda line: None)
+        with _PeakMemory() as memory:
+            summary = derender([Path(tmp) / "full"], predictor, options, say=lambda line: None)
         full = time.perf_counter() - start
     return {
         "network_images_per_s": round(net_wall, 2),
@@ -176,13 +239,15 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         "full_images_per_s": round(len(summary.done) / full, 3),
         "full_seconds_per_image": round(full / max(len(summary.done), 1), 2),
         "failed": len(summary.failures),
-        "full_peak_rss_mib": round(_peak_rss_mib(), 1),
+        "full_peak_rss_mib": round(memory.rss, 1),
+        "full_peak_pss_mib": round(memory.pss, 1),
         **cost,
         "image_size": size,
         "photo_side": photo_side,
         "batch_size": batch_size,
         "n_images": n_images,
         "n_export": n_export,
+        "n_full": n_full,
         "device": str(predictor.device),
         "threads": threads,
         "workers": workers,
