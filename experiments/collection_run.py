@@ -23,6 +23,8 @@ from pathlib import Path
 
 from PIL import Image, ImageDraw
 
+from radar_cli.process_memory import tree_memory_mib
+
 REPO = Path(__file__).resolve().parents[1]
 PHOTO_SIDE = 819
 
@@ -39,31 +41,6 @@ def tile_examples(out: Path, n: int) -> None:
         image.save(out / f"photo_{k:04d}.jpg", quality=92)
 
 
-def _tree(pid: int) -> list[int]:
-    """pid and its descendants (Linux /proc)."""
-    try:
-        children = Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
-    except OSError:
-        return [pid]
-    return [pid] + [p for child in children for p in _tree(int(child))]
-
-
-def _memory_mib(pid: int) -> tuple[float, float] | None:
-    """(RSS, PSS) in MiB of pid and its descendants together, None when it has ended."""
-    rss = pss = 0
-    for p in _tree(pid):
-        try:
-            for line in Path(f"/proc/{p}/smaps_rollup").read_text().splitlines():
-                if line.startswith("Rss:"):
-                    rss += int(line.split()[1])
-                elif line.startswith("Pss:"):
-                    pss += int(line.split()[1])
-        except OSError:
-            if p == pid:
-                return None
-    return rss / 1024, pss / 1024
-
-
 def run(photos: Path, results: Path, table: Path, every: float, limit_s: float, options: list[str]) -> int:
     """`radar derender photos --out results options`, sampled into `table`; its exit code."""
     cmd = [sys.executable, "-m", "radar_cli", "derender", str(photos), "--out", str(results), *options]
@@ -73,7 +50,7 @@ def run(photos: Path, results: Path, table: Path, every: float, limit_s: float, 
         writer = csv.writer(f)
         writer.writerow(("t_s", "rss_mib", "pss_mib", "objects_done"))
         while proc.poll() is None:
-            memory = _memory_mib(proc.pid)
+            memory = tree_memory_mib(proc.pid)
             elapsed = time.monotonic() - start
             if memory is not None:
                 writer.writerow((round(elapsed, 1), round(memory[0], 1), round(memory[1], 1),

@@ -12,8 +12,8 @@ PACKAGE = Path(__file__).resolve().parents[1] / "radar_cli"
 
 # lowest first; a module may import from its own layer's package or any layer listed before it
 LAYERS: list[set[str]] = [
-    {"errors", "checks", "config", "fileio", "threads", "blas_threads", "distributed", "allocator", "dataset",
-     "results", "sizes", ""},
+    {"errors", "checks", "config", "fileio", "threads", "blas_threads", "distributed", "allocator",
+     "process_memory", "dataset", "results", "sizes", ""},
     {"harvest"},
     {"sor"},
     {"render"},

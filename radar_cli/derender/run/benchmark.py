@@ -3,11 +3,9 @@ export, and the seconds and memory of one object's export at the output resoluti
 
 from __future__ import annotations
 
-import os
 import resource
 import statistics
 import tempfile
-import threading
 import time
 from pathlib import Path
 
@@ -21,6 +19,7 @@ from radar_cli.derender.run.inputs import DEFAULT_RESOLUTION, InputItem, Resolut
 from radar_cli.derender.run.predictor import AlbedoSource, PitchSource, Predictor
 from radar_cli.derender.run.upsample import full_resolution_state
 from radar_cli.fileio import write_image
+from radar_cli.process_memory import PeakMemory
 from radar_cli.threads import torch_threads
 
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
@@ -39,61 +38,6 @@ def _rss_mib() -> float:
 def _peak_rss_mib() -> float:
     """This process's peak resident memory so far, MiB (ru_maxrss is KiB on Linux)."""
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-
-
-def _tree(pid: int) -> list[int]:
-    """pid and its descendants (Linux /proc; just pid elsewhere)."""
-    try:
-        children = Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
-    except OSError:
-        return [pid]
-    return [pid] + [p for child in children for p in _tree(int(child))]
-
-
-def _proc_kib(path: str, key: str) -> int:
-    """The KiB figure after `key` in a /proc file (0 where there is none)."""
-    try:
-        for line in Path(path).read_text().splitlines():
-            if line.startswith(key):
-                return int(line.split()[1])
-    except (OSError, ValueError, IndexError):
-        pass
-    return 0
-
-
-class _PeakMemory:
-    """The memory of this process and its workers together while the block runs: `rss`, the sum of each
-    process's own peak resident set (the kernel's VmHWM, read every RSS_S: no peak is missed, and the sum bounds
-    the processes' peak together from above), and `pss`, the peak of their proportional set sizes summed (read
-    every PSS_S: smaps_rollup walks a process's whole memory map, too costly to read often), MiB."""
-
-    RSS_S, PSS_S = 0.1, 1.0
-
-    def __enter__(self) -> "_PeakMemory":
-        self.hwm: dict[int, int] = {}
-        self.pss = 0.0
-        self.stop = threading.Event()
-        self.thread = threading.Thread(target=self._sample, daemon=True)
-        self.thread.start()
-        return self
-
-    def _sample(self) -> None:
-        last_pss = 0.0
-        while not self.stop.wait(self.RSS_S):
-            pids = _tree(os.getpid())
-            for pid in pids:
-                self.hwm[pid] = max(self.hwm.get(pid, 0), _proc_kib(f"/proc/{pid}/status", "VmHWM:"))
-            if time.monotonic() - last_pss >= self.PSS_S:
-                last_pss = time.monotonic()
-                self.pss = max(self.pss, sum(_proc_kib(f"/proc/{pid}/smaps_rollup", "Pss:") for pid in pids) / 1024)
-
-    @property
-    def rss(self) -> float:
-        return sum(self.hwm.values()) / 1024
-
-    def __exit__(self, *exc: object) -> None:
-        self.stop.set()
-        self.thread.join()
 
 
 def _photos(n: int, size: int, seed: int = 0) -> list[np.ndarray]:
@@ -209,7 +153,7 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
          "export_state_seconds", "export_write_seconds", "export_seconds_per_object",
          "export_cpu_seconds_per_object" (process CPU time: steadier than wall time on a shared machine),
          "rss_before_export_mib", "peak_rss_mib" (after the one-at-a-time exports), "full_peak_rss_mib" and
-         "full_peak_pss_mib" (the full run's processes together, _PeakMemory), "image_size", "photo_side",
+         "full_peak_pss_mib" (the full run's processes together, process_memory.PeakMemory), "image_size", "photo_side",
          "batch_size", "n_images", "n_export", "n_full", "device", "threads", "workers", "albedo", "pitch",
          "model"}; the export figures are medians over the objects.
     """
@@ -230,7 +174,7 @@ def bench_derender(checkpoint: str | Path | None = None, device: str = "cpu", n_
         options = DerenderOptions(out=Path(tmp) / "out", batch_size=batch_size, workers=workers, threads=threads,
                                   export=export, resolution=resolution, processes=True)
         start = time.perf_counter()
-        with _PeakMemory() as memory:
+        with PeakMemory() as memory:
             summary = derender([Path(tmp) / "full"], predictor, options, say=lambda line: None)
         full = time.perf_counter() - start
     return {
