@@ -215,7 +215,7 @@ def foreground_evidence(image: np.ndarray, band: np.ndarray | None = None, shadi
 
 
 def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float,
-                   band: np.ndarray | None = None) -> np.ndarray:
+                   band: np.ndarray | None = None, cuts: dict[bytes, np.ndarray] | None = None) -> np.ndarray:
     """H x W bool object pixels of a detection-scale photo: GrabCut over the whole image, started from the
     evidence (above `threshold`, holes filled: probable object; a thin ring around it: probable backdrop; beyond
     it and `backdrop_seeds` in the border band: sure backdrop). Falls back to the thresholded evidence if
@@ -230,6 +230,9 @@ def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float,
     Args:
         image: H x W x 3 uint8 RGB. evidence: H x W in [0, 1] (`foreground_evidence`).
         band: H x W bool, the border pixels that show backdrop (default: `backdrop_band`).
+        cuts: GrabCut's labels by the labels it started from, for calls on the same image: a cut is a function
+            of the image and its start (fresh colour models, the generator seeded), so two readings that start
+            alike (a clean backdrop, read with its shading forgiven or not) share one.
     """
     raw = evidence > threshold
     if not raw.any():
@@ -241,14 +244,20 @@ def coarse_grabcut(image: np.ndarray, evidence: np.ndarray, threshold: float,
     tri[seed] = cv2.GC_PR_FGD
     sure = backdrop_seeds(image, band)
     tri[sure] = cv2.GC_BGD
-    bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
-    cv2.setRNGSeed(0)  # GrabCut's k-means draws from a per-thread generator: the same cut in any thread
-    try:
-        # OpenCV's stubs want a rectangle; None is what GC_INIT_WITH_MASK takes
-        cv2.grabCut(np.ascontiguousarray(image), tri, None, bgd, fgd, COARSE_ITERATIONS,  # type: ignore[call-overload]
-                    cv2.GC_INIT_WITH_MASK)
-    except cv2.error:
-        return raw
+    start = tri.tobytes()
+    if cuts is not None and start in cuts:
+        tri = cuts[start].copy()
+    else:
+        bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
+        cv2.setRNGSeed(0)  # GrabCut's k-means draws from a per-thread generator: the same cut in any thread
+        try:
+            # OpenCV's stubs want a rectangle; None is what GC_INIT_WITH_MASK takes
+            cv2.grabCut(np.ascontiguousarray(image), tri, None, bgd, fgd,  # type: ignore[call-overload]
+                        COARSE_ITERATIONS, cv2.GC_INIT_WITH_MASK)
+        except cv2.error:
+            return raw
+        if cuts is not None:
+            cuts[start] = tri.copy()
     cut = (tri == cv2.GC_FGD) | (tri == cv2.GC_PR_FGD)
     # GrabCut trims backdrop that the evidence took for object; if it breaks a modest object up instead (a flat
     # object seen only by its outline), the evidence stands
@@ -360,17 +369,18 @@ def _groups(boxes: list[tuple[int, int, int, int]], gap: float) -> list[list[int
 
 
 def _cut(small: np.ndarray, band: np.ndarray, padding: np.ndarray, threshold: float, thorough: bool,
-         shading: bool, *, first: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+         shading: bool, *, first: np.ndarray | None = None,
+         cuts: dict[bytes, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(evidence, object pixels) of a detection-scale photo (see `detect`); `first`: its first evidence, from the
-    border band, if already known."""
+    border band, if already known; `cuts` as coarse_grabcut's."""
     evidence = foreground_evidence(small, band, shading) if first is None else first
-    raw = coarse_grabcut(small, evidence, threshold, band) & ~padding
+    raw = coarse_grabcut(small, evidence, threshold, band, cuts) & ~padding
     if thorough and raw.any():  # model the backdrop again from all round the object, not only the border
         # (vignettes, light pools, a stand's surroundings), and cut again
         clear = ~(cv2.dilate(_clean(raw).astype(np.uint8), _square(RING * max(raw.shape))) > 0)
         if clear.mean() > RING:
             evidence = foreground_evidence(small, (clear | band) & ~padding, shading)
-            raw = coarse_grabcut(small, evidence, threshold, band) & ~padding
+            raw = coarse_grabcut(small, evidence, threshold, band, cuts) & ~padding
     return evidence, raw
 
 
@@ -441,9 +451,10 @@ def detect(image: np.ndarray, threshold: float = 0.5, thorough: bool = False) ->
     # shade)
     lead = 0.0 if is_greyscale(small) else SHADING_LEAD
     strict = functools.cache(lambda: foreground_evidence(small, band, shading=False))  # glanced at, then read
+    cuts: dict[bytes, np.ndarray] = {}
     evidence, raw, mask = _best_reading(
         small, lambda shading: _cut(small, band, padding, threshold, thorough, shading,
-                                    first=None if shading else strict()), lead,
+                                    first=None if shading else strict(), cuts=cuts), lead,
         lambda: _clean(strict() > threshold) & ~padding)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     if n <= 1:

@@ -249,3 +249,30 @@ def test_the_strict_reading_is_made_only_when_it_could_win(vases, monkeypatch, s
         assert area >= D.READING_SHARE * max(area, strict_area) and support + lead >= strict_support
         assert not (strict_area >= D.GROWTH * area and strict_support >= support - D.GROWTH_SLACK)
         assert not (found[0].mask & ~forgiving).any()  # the object found is the forgiving reading's
+
+
+def test_readings_that_start_alike_share_one_grabcut(monkeypatch):
+    """A clean white backdrop read with its shading forgiven and not, once and again from all round the object,
+    gives GrabCut the same start each time: it runs once, and the detection is the one of four separate runs."""
+    from radar_cli.fileio import read_image
+    from radar_cli.masks import detect as detection
+
+    photo = read_image(Path(__file__).resolve().parents[2] / "examples" / "synthetic_vase_0.png")
+    calls = []
+    grabcut = detection.cv2.grabCut
+
+    def counting(*args):
+        calls.append(1)
+        return grabcut(*args)
+
+    monkeypatch.setattr(detection.cv2, "grabCut", counting)
+    shared = detection.detect(photo, thorough=True)
+    runs = len(calls)
+    unshared = detection.coarse_grabcut
+    monkeypatch.setattr(detection, "coarse_grabcut", lambda image, evidence, threshold, band, cuts: unshared(
+        image, evidence, threshold, band))
+    calls.clear()
+    separate = detection.detect(photo, thorough=True)
+    assert runs == 1 and len(calls) == 4
+    assert len(shared) == len(separate) == 1
+    assert np.array_equal(shared[0].mask, separate[0].mask) and shared[0].box == separate[0].box
