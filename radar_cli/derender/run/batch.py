@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Callable, TypeVar
 
 import numpy as np
+import torch
 from tqdm import tqdm
 
 from radar_cli.allocator import keep_freed_memory
@@ -276,7 +277,7 @@ def _on_processes(batches: list[list[InputItem]], several: list[InputItem], pred
                           f"not de-rendered: {reason}")
         return _Outcome([], [failure], [failure.line()])
 
-    payload = pickle.dumps((predictor, one, envs))
+    payload = pickle.dumps((predictor, one, envs))  # for our own worker processes only: never written to disk
     outcomes = spread(tasks, functools.partial(_run_task, predictor=predictor, options=one, envs=envs, sizes=sizes),
                       functools.partial(_process_worker, payload), options.workers - 1, arrived, lost)
     for outcome in outcomes:
@@ -288,9 +289,7 @@ def _process_worker(payload: bytes) -> Callable[[_Task], _Outcome]:
     """In a spawned worker process: the model, options and environments unpickled, the run's settings made (the
     allocator's, torch's threads), and the task runner over them."""
     keep_freed_memory()
-    predictor, options, envs = pickle.loads(payload)
-    import torch
-
+    predictor, options, envs = pickle.loads(payload)  # made by the run's own process, passed by a pipe
     torch.set_num_threads(options.threads)
     sizes = SizeFinder(options.dimensions)  # open for the process's life: its catalogs' connections are its own
     return functools.partial(_run_task, predictor=predictor, options=options, envs=envs, sizes=sizes)
