@@ -58,7 +58,7 @@ def test_one_task_or_no_helper_runs_here(tasks) -> None:
 
 
 @pytest.mark.parametrize("workers", [2, 3])
-def test_objects_on_worker_processes_are_the_same_bytes_and_a_bad_photo_is_recorded(tmp_path: Path,
+def test_objects_on_worker_processes_are_the_same_bytes_and_bad_photos_are_recorded(tmp_path: Path,
                                                                                       workers: int) -> None:
     from radar_cli.derender.export.object_folder import ExportConfig
     from radar_cli.derender.run.batch import DerenderOptions, derender
@@ -70,14 +70,18 @@ def test_objects_on_worker_processes_are_the_same_bytes_and_a_bad_photo_is_recor
     for k in range(5):
         write_photo(tmp_path / "in" / f"vase_{k}.png", 40 + k, (96, 80))
     (tmp_path / "in" / "broken.png").write_bytes(b"\x89PNG\r\n\x1a\n not an image")
+    for view in ("front", "back", "side"):  # a multi-view object: one task, its unreadable photo recorded
+        write_photo(tmp_path / "in" / "pot" / f"{view}.png", 3, (96, 80))
+    (tmp_path / "in" / "pot" / "broken.jpg").write_bytes(b"not a jpeg")
     predictor = Predictor.from_checkpoint(None, "cpu", refine="none")
     runs, said = {}, []
     for processes in (False, True):
         options = DerenderOptions(out=tmp_path / f"p{processes}", workers=workers if processes else 1,
                                   processes=processes, export=ExportConfig(views=2, view_size=32), resolution=96)
         summary = derender([tmp_path / "in"], predictor, options, say=said.append)
-        assert summary.done == [f"vase_{k}" for k in range(5)]
-        assert [Path(f.source).name for f in summary.failures] == ["broken.png"]
+        assert summary.done == [f"vase_{k}" for k in range(5)] + ["pot"]
+        assert sorted(Path(f.source).name for f in summary.failures) == ["broken.jpg", "broken.png"]
         runs[processes] = object_files(options.out)
     assert len(runs[True]) > 50 and runs[True] == runs[False]
-    assert sum("broken.png" in line for line in said) == 2  # said once by each run, whichever process met it
+    for name in ("broken.png", "broken.jpg"):  # said once by each run, whichever process met it
+        assert sum(name in line for line in said) == 2
