@@ -70,7 +70,7 @@ PRUNE_MARGIN = 1e-4
 """A disc is left out of a run of lines only when its nearest point there is this far (normalised units, 1/40 px
 at 512 px) beyond the sampled discs' end on every line of the run: far more than the crossings' rounding (~1e-8
 at a tangent)."""
-PART_LINES = 8
+RUN_LINES = 8
 """The lines a disc spans are tested for pruning in runs of this many: a wide ellipse (a disc seen from above, in
 the columns' pass) holds the ends only near its own extremes, and is left out of the runs between them."""
 
@@ -84,7 +84,7 @@ def disc_winners(conic: tuple[torch.Tensor, ...], low: torch.Tensor, high: torch
     crosses the line.
 
     Each ellipse is evaluated only on the lines it spans, and only where it can win: a sample of the discs is
-    evaluated first, and on each run of PART_LINES lines a disc whose leftmost point there lies beyond the
+    evaluated first, and on each run of RUN_LINES lines a disc whose leftmost point there lies beyond the
     sample's left end on every line of the run (and whose rightmost point short of the right end) cannot hold an
     end there, nor tie one. An ellipse's left edge is convex in the line's height and its right edge concave, so
     a run's leftmost point is the ellipse's own where that lies in the run's heights, else at one of the run's
@@ -105,15 +105,15 @@ def disc_winners(conic: tuple[torch.Tensor, ...], low: torch.Tensor, high: torch
     done = _evaluate(conic, first, last, sample.flatten(), lines)
     left = _line_best(done[0], done[2], done[3], batch, n, "amin")  # B x N, inf where no sampled disc crosses
     right = _line_best(done[1], done[2], done[3], batch, n, "amax")
-    parts = max(-(-int((last - first).max() + 1) // PART_LINES), 1)
-    part_first = first[..., None] + PART_LINES * torch.arange(parts, device=first.device)  # B x K x P
-    part_last = torch.minimum(part_first + PART_LINES - 1, last[..., None])
-    nearest = _run_extremes(conic, low, high, extremes, part_first, part_last, lines)
-    flat_first, flat_last = part_first.flatten(1), part_last.flatten(1)  # B x KP
+    runs = max(-(-int((last - first).max() + 1) // RUN_LINES), 1)
+    run_first = first[..., None] + RUN_LINES * torch.arange(runs, device=first.device)  # B x K x P
+    run_last = torch.minimum(run_first + RUN_LINES - 1, last[..., None])
+    nearest = _run_extremes(conic, low, high, extremes, run_first, run_last, lines)
+    flat_first, flat_last = run_first.flatten(1), run_last.flatten(1)  # B x KP
     beyond = (nearest[0].flatten(1) > _range_reduce(left, flat_first, flat_last, torch.maximum) + PRUNE_MARGIN) & (
         nearest[1].flatten(1) < _range_reduce(right, flat_first, flat_last, torch.minimum) - PRUNE_MARGIN)
-    chosen = ((spans & ~sample)[..., None] & (part_first <= part_last)).flatten(1) & ~beyond
-    more = _evaluate(conic, flat_first, flat_last, chosen.flatten(), lines, parts)
+    chosen = ((spans & ~sample)[..., None] & (run_first <= run_last)).flatten(1) & ~beyond
+    more = _evaluate(conic, flat_first, flat_last, chosen.flatten(), lines, runs)
     lo, hi, target, inside, disc = (torch.cat([a, b]) for a, b in zip(done, more))
     return (winner(lo, target, inside, disc, batch, n, "amin", k),
             winner(hi, target, inside, disc, batch, n, "amax", k))
@@ -121,13 +121,13 @@ def disc_winners(conic: tuple[torch.Tensor, ...], low: torch.Tensor, high: torch
 
 def _run_extremes(conic: tuple[torch.Tensor, ...], low: torch.Tensor, high: torch.Tensor,
                   extremes: tuple[tuple[torch.Tensor, torch.Tensor], tuple[torch.Tensor, torch.Tensor]],
-                  part_first: torch.Tensor, part_last: torch.Tensor,
+                  run_first: torch.Tensor, run_last: torch.Tensor,
                   lines: tuple[float, float, int]) -> tuple[torch.Tensor, torch.Tensor]:
     """The leftmost and rightmost x of each ellipse (B x K, as disc_winners) over the heights of each run of lines
     (B x K x P, first .. last) clamped to its span [low, high]; -inf and inf (never pruned) for conics that are no
     ellipse. B x K x P each."""
     y0, dy, _ = lines
-    ends = [y0 + i.to(low.dtype) * dy for i in (part_first, part_last)]
+    ends = [y0 + i.to(low.dtype) * dy for i in (run_first, run_last)]
     bottom = torch.maximum(torch.minimum(*ends), low[..., None]).clamp(max=high[..., None])
     top = torch.minimum(torch.maximum(*ends), high[..., None]).clamp(min=low[..., None])
     q00, q01, q02, q11, q12, q22 = (c[..., None] for c in conic)
@@ -149,10 +149,10 @@ def _run_extremes(conic: tuple[torch.Tensor, ...], low: torch.Tensor, high: torc
 
 
 def _evaluate(conic: tuple[torch.Tensor, ...], first: torch.Tensor, last: torch.Tensor, chosen: torch.Tensor,
-              lines: tuple[float, float, int], parts: int = 1) -> tuple[torch.Tensor, ...]:
-    """The crossings of the chosen discs' runs of lines (flat B x KP bool; `parts` runs per disc, first .. last
-    each, B x KP), in BAND_GROUPS groups of similar widths: flat (lo, hi, b (N + 1) + line, on a line, disc
-    index)."""
+              lines: tuple[float, float, int], per_disc: int = 1) -> tuple[torch.Tensor, ...]:
+    """The crossings of the chosen discs' runs of lines (flat B x KP bool; P = `per_disc` runs per disc,
+    first .. last each, B x KP), in BAND_GROUPS groups of similar widths: flat (lo, hi, b (N + 1) + line, on a
+    line, disc index)."""
     y0, dy, n = lines
     runs = first.shape[1]
     first, last = first.flatten(), last.flatten()
@@ -168,8 +168,8 @@ def _evaluate(conic: tuple[torch.Tensor, ...], first: torch.Tensor, last: torch.
         inside = index <= last[group, None]
         index = torch.where(inside, index, torch.full_like(index, n))
         b, run = group // runs, group % runs
-        disc = run // parts
-        at = (b * (runs // parts) + disc)[:, None]
+        disc = run // per_disc
+        at = (b * (runs // per_disc) + disc)[:, None]
         crossing = crossings(tuple(c[at] for c in coefficients), y0 + index.to(conic[0].dtype) * dy)
         for i, t in enumerate((*crossing, index + b[:, None] * (n + 1), inside, disc[:, None])):
             out[i].append(t.expand_as(index).flatten())

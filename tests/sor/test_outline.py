@@ -127,7 +127,7 @@ def test_wide_ellipses_are_left_out_between_their_extremes_and_the_winners_stay(
     monkeypatch.setattr(conic_lines, "_evaluate", counting)
     monkeypatch.setattr(conic_lines, "SAMPLE_MIN", 0)
     pruned = outline(solid, 384, CameraConfig())
-    monkeypatch.setattr(conic_lines, "PART_LINES", 10**6)  # one run per disc: the disc's whole span
+    monkeypatch.setattr(conic_lines, "RUN_LINES", 10**6)  # one run per disc: the disc's whole span
     whole = outline(solid, 384, CameraConfig())
     monkeypatch.setattr(conic_lines, "SAMPLE_MIN", 10**12)  # every disc on every line it spans
     dense = outline(solid, 384, CameraConfig())

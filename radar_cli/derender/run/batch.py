@@ -298,7 +298,8 @@ def _process_worker(payload: bytes) -> Callable[[_Task], _Outcome]:
 def _run_task(task: _Task, predictor: Predictor, options: DerenderOptions, envs: dict[str, np.ndarray],
               sizes: SizeFinder) -> _Outcome:
     """De-render one object in this process (options.workers 1)."""
-    summary, said = BatchSummary(), list[str]()
+    summary = BatchSummary()
+    said: list[str] = []
     if task.views:
         _run_views(task.item, predictor, options, envs, summary, said.append, sizes)
     else:
