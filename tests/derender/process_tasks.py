@@ -17,8 +17,12 @@ def square(task: int) -> tuple[int, int]:
     return task * task, os.getpid()
 
 
-def square_worker() -> Callable[[int], tuple[int, int]]:
-    return square
+def square_worker(marker: Path) -> Callable[[int], tuple[int, int]]:
+    """square, touching `marker` first: the helper has taken a task."""
+    def work(task: int) -> tuple[int, int]:
+        marker.touch()
+        return square(task)
+    return work
 
 
 def dying_worker(marker: Path) -> Callable[[str], str]:

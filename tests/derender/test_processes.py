@@ -23,13 +23,22 @@ def tasks(monkeypatch):
     return process_tasks
 
 
-def test_every_task_runs_once_and_results_come_in_task_order(tasks) -> None:
+def test_every_task_runs_once_and_results_come_in_task_order(tasks, tmp_path: Path) -> None:
+    marker = tmp_path / "helper-started"
+
+    def here(task: int) -> tuple[int, int]:
+        if task == 0:  # held until the helper has taken a task, however slowly it starts
+            deadline = time.monotonic() + 60
+            while not marker.exists() and time.monotonic() < deadline:
+                time.sleep(0.05)
+        return tasks.square(task)
+
     seen: list[tuple[int, int]] = []
-    results = spread(list(range(16)), tasks.square, tasks.square_worker, 1, seen.append, lambda task, why: (-1, 0))
+    results = spread(list(range(16)), here, functools.partial(tasks.square_worker, marker), 1, seen.append,
+                     lambda task, why: (-1, 0))
     assert [value for value, _ in results] == [k * k for k in range(16)]
     assert sorted(value for value, _ in seen) == sorted(k * k for k in range(16))
-    assert len({pid for _, pid in results}) == 2  # the helper took some while this process did the others
-    assert {pid for _, pid in results} >= {os.getpid()}
+    assert len({pid for _, pid in results}) == 2 and results[0][1] == os.getpid()  # both processes took tasks
 
 
 def test_a_task_whose_helper_died_is_reported_lost_and_the_rest_are_done(tasks, tmp_path: Path) -> None:
@@ -50,11 +59,12 @@ def test_a_task_whose_helper_died_is_reported_lost_and_the_rest_are_done(tasks, 
     assert results[2:] == ["main a", "main b", "main c"]
 
 
-def test_one_task_or_no_helper_runs_here(tasks) -> None:
+def test_one_task_or_no_helper_runs_here(tasks, tmp_path: Path) -> None:
     none = lambda t, w: (-1, 0)  # noqa: E731
-    assert spread([3], tasks.square, tasks.square_worker, 4, lambda r: None, none) == [(9, os.getpid())]
-    assert spread([1, 2], tasks.square, tasks.square_worker, 0, lambda r: None, none) == [(1, os.getpid()),
-                                                                                           (4, os.getpid())]
+    setup = functools.partial(tasks.square_worker, tmp_path / "helper-started")
+    assert spread([3], tasks.square, setup, 4, lambda r: None, none) == [(9, os.getpid())]
+    assert spread([1, 2], tasks.square, setup, 0, lambda r: None, none) == [(1, os.getpid()), (4, os.getpid())]
+    assert not (tmp_path / "helper-started").exists()
 
 
 @pytest.mark.parametrize("workers", [2, 3])
