@@ -14,7 +14,6 @@ from radar_cli.render.lighting import tone_map
 from radar_cli.render.scene import shade
 from radar_cli.render.texture import front_third
 from radar_cli.results import (
-    ALBEDO_FILE,
     DIFFUSE_FILE,
     ENV_HDR_FILE,
     ENV_MAP_FILE,
@@ -65,7 +64,8 @@ def write_env(folder: Path, env: np.ndarray, gamma: float) -> None:
 
 
 def write_maps(folder: Path, state: ObjectState, tex_render) -> None:
-    """Write the unwrapped maps of one object.
+    """Write the unwrapped maps of one object, but for the albedo: ALBEDO_FILE is the meshes' texture, written
+    with them (export.mesh.write_meshes).
 
     Args:
         folder: the object's results folder.
@@ -73,7 +73,6 @@ def write_maps(folder: Path, state: ObjectState, tex_render) -> None:
         tex_render: RenderConfig of the network (its shading grid is used for the frontal maps).
     """
     gamma = state.render.gamma
-    write_picture(folder / ALBEDO_FILE, chw_image(tone_map(state.material.albedo, gamma)))
     front = front_third(state.material.albedo)  # 1 x 3 x Ht x Wt
     s = shade(state.solid, state.material.with_albedo(front), tex_render,
               state.camera)

@@ -16,7 +16,7 @@ from radar_cli.derender.export.maps import chw_image
 from radar_cli.derender.run.state import ObjectState, roughness_from_shininess
 from radar_cli.fileio import write_bytes
 from radar_cli.render.lighting import tone_map
-from radar_cli.results import MESH_GLB_FILE, MESH_OBJ_FILE
+from radar_cli.results import ALBEDO_FILE, MESH_GLB_FILE, MESH_OBJ_FILE
 from radar_cli.sor.mesh import triangulate
 
 # canonical frame (seen side at -z) -> export frame (seen side at +z): a proper rotation, so winding is kept
@@ -59,8 +59,8 @@ def to_real_size(mesh: trimesh.Trimesh, height_cm: float) -> dict[str, float]:
 
 
 def write_meshes(folder: Path, state: ObjectState, n_cols: int, height_cm: float | None = None) -> dict | None:
-    """mesh.glb, and mesh.obj with its material.mtl and texture PNG, written atomically; in metres when the
-    object's `height_cm` is given.
+    """mesh.glb, and mesh.obj with its material.mtl and texture PNG (ALBEDO_FILE, the object's albedo map),
+    written atomically; in metres when the object's `height_cm` is given.
 
     Returns:
         The meshes' height and widest diameter in cm (to_real_size), or None when unitless.
@@ -77,8 +77,10 @@ def write_meshes(folder: Path, state: ObjectState, n_cols: int, height_cm: float
         name="albedo", image=material.baseColorTexture, diffuse=(255, 255, 255, 255),
         ambient=(255, 255, 255, 255), specular=(spec, spec, spec, 255), glossiness=float(state.material.alpha[0]))
     phong.image.encoderinfo = dict(TEXTURE_PNG)
-    files, name = phong.to_obj(name="albedo")  # {albedo.png, albedo.mtl}: the texture and its Phong material
+    files, name = phong.to_obj(name=Path(ALBEDO_FILE).stem)  # the texture and its Phong material
     mtl = files.pop(f"{name}.mtl")
+    if ALBEDO_FILE not in files:
+        raise OSError(f"the OBJ exporter named the texture {sorted(files)!r}, not {ALBEDO_FILE}")
     files[OBJ_MTL] = f"# {OBJ_HEADER}\n\n".encode() + mtl
     for file_name, data in files.items():
         if Path(file_name).name != file_name:  # trimesh names these; never write outside the folder
