@@ -19,26 +19,39 @@ def process_tree(pid: int) -> list[int]:
     return [pid] + [p for child in children for p in process_tree(int(child))]
 
 
-def proc_kib(path: str, key: str) -> int:
-    """The KiB figure after `key` in a /proc file (0 where there is none)."""
+def proc_kib(path: str, *keys: str) -> list[int]:
+    """The KiB figures after each of `keys` in a /proc file, read once (0 for a key it lacks or a file gone)."""
+    found = dict.fromkeys(keys, 0)
     try:
         for line in Path(path).read_text().splitlines():
-            if line.startswith(key):
-                return int(line.split()[1])
+            key = line.split(maxsplit=1)[0] if line else ""
+            if key in found:
+                found[key] = int(line.split()[1])
     except (OSError, ValueError, IndexError):
         pass
-    return 0
+    return [found[key] for key in keys]
+
+
+def _reset_peak() -> None:
+    """Start this process's VmHWM afresh (Linux >= 4.0: "5" to clear_refs), so the peak is the block's, not the
+    one of whatever the process did before it; a no-op where that is refused."""
+    try:
+        Path("/proc/self/clear_refs").write_text("5")
+    except OSError:
+        pass
 
 
 class PeakMemory:
     """The memory of this process and its workers together while the block runs: `rss`, the sum of each
     process's own peak resident set (the kernel's VmHWM, read every RSS_S: no peak is missed, and the sum bounds
     the processes' peak together from above), and `pss`, the peak of their proportional set sizes summed (read
-    every PSS_S: smaps_rollup walks a process's whole memory map, too costly to read often), MiB."""
+    every PSS_S: smaps_rollup walks a process's whole memory map, too costly to read often), MiB. This process's
+    own peak starts at the block's start; its workers start within it."""
 
     RSS_S, PSS_S = 0.1, 1.0
 
     def __enter__(self) -> "PeakMemory":
+        _reset_peak()
         self.hwm: dict[int, int] = {}
         self.pss = 0.0
         self.stop = threading.Event()
@@ -51,10 +64,10 @@ class PeakMemory:
         while not self.stop.wait(self.RSS_S):
             pids = process_tree(os.getpid())
             for pid in pids:
-                self.hwm[pid] = max(self.hwm.get(pid, 0), proc_kib(f"/proc/{pid}/status", "VmHWM:"))
+                self.hwm[pid] = max(self.hwm.get(pid, 0), proc_kib(f"/proc/{pid}/status", "VmHWM:")[0])
             if time.monotonic() - last_pss >= self.PSS_S:
                 last_pss = time.monotonic()
-                self.pss = max(self.pss, sum(proc_kib(f"/proc/{pid}/smaps_rollup", "Pss:") for pid in pids) / 1024)
+                self.pss = max(self.pss, sum(proc_kib(f"/proc/{pid}/smaps_rollup", "Pss:")[0] for pid in pids) / 1024)
 
     @property
     def rss(self) -> float:
@@ -69,6 +82,6 @@ def tree_memory_mib(pid: int) -> tuple[float, float] | None:
     """(RSS, PSS) now of pid and its descendants together, MiB; None when pid has ended."""
     if not Path(f"/proc/{pid}").exists():
         return None
-    pids = process_tree(pid)
-    return (sum(proc_kib(f"/proc/{p}/smaps_rollup", "Rss:") for p in pids) / 1024,
-            sum(proc_kib(f"/proc/{p}/smaps_rollup", "Pss:") for p in pids) / 1024)
+    rss, pss = (sum(values) / 1024 for values in zip(*(proc_kib(f"/proc/{p}/smaps_rollup", "Rss:", "Pss:")
+                                                       for p in process_tree(pid))))
+    return rss, pss
