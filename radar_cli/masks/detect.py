@@ -45,7 +45,8 @@ SHADING_LEAD = 0.05  # on a colour photo the reading that forgives shading wins 
 GROWTH = 1.5  # ... or unless the other reading's object is this many times as large ...
 GROWTH_SLACK = 0.02  # ... with its outline on the photo's edges nearly as well (support at most this much lower)
 SYMMETRIC_GROWTH = 1.03  # ... or unless the other reading's object is this many times as large and as symmetric
-SYMMETRY_SLACK = 0.01  # ... about an axis (its solid-of-revolution score at most this much lower)
+SYMMETRY_SLACK = 0.01  # ... about an axis (its solid-of-revolution score at most this much lower) ...
+SYMMETRY_SUPPORT_SLACK = 0.08  # ... with its outline on the photo's edges nearly as well (support at most this lower)
 
 
 @dataclass(frozen=True)
@@ -405,8 +406,11 @@ def _best_reading(small: np.ndarray, read: Callable[[bool], tuple[np.ndarray, np
     at most GROWTH_SLACK lower: shade does not add half again to an object and keep its outline on sharp edges;
     a black body on a dark sweep, or a white one on a pale backdrop, that the forgiving reading took for shade
     does. And it wins where its object is SYMMETRIC_GROWTH times as large and its largest part at most
-    SYMMETRY_SLACK less symmetric about an axis (`quality.sor_score`): a shadow cast beside the vessel makes
-    the object lopsided, a neighbour taken in as well; the vessel's own dark lower body does not.
+    SYMMETRY_SLACK less symmetric about an axis (`quality.sor_score`) and its support at most
+    SYMMETRY_SUPPORT_SLACK lower: a shadow cast beside the vessel makes the object lopsided, a neighbour taken in
+    as well; the vessel's own dark lower body does not. A pool of light on the floor, centred under the vessel,
+    is as symmetric, but its soft edge is no edge in the photo (a greyscale photo, where the vessel's pale foot
+    and the lit floor are one grey: the strict reading takes the floor in, its support 0.12-0.24 lower).
 
     The second reading is made only if it could win: not where the first one's object covers READING_SHARE of
     the photo (so it counts however large the other's is), its score reaches 1 (the most the other can score)
@@ -424,7 +428,7 @@ def _best_reading(small: np.ndarray, read: Callable[[bool], tuple[np.ndarray, np
     strict_score = strict_support if strict_area >= READING_SHARE * largest else -1.0
     grown = strict_area >= GROWTH * area and strict_support >= support - GROWTH_SLACK
     keep = score >= strict_score and not grown and not (  # the symmetry is read only where it can decide
-        strict_area >= SYMMETRIC_GROWTH * area
+        strict_area >= SYMMETRIC_GROWTH * area and strict_support >= support - SYMMETRY_SUPPORT_SLACK
         and sor_score(main_component(strict_cleaned)) >= sor_score(main_component(cleaned)) - SYMMETRY_SLACK)
     return (*forgiving, cleaned) if keep else (*strict, strict_cleaned)
 

@@ -276,3 +276,52 @@ def test_readings_that_start_alike_share_one_grabcut(monkeypatch):
     assert runs == 1 and len(calls) == 4
     assert len(shared) == len(separate) == 1
     assert np.array_equal(shared[0].mask, separate[0].mask) and shared[0].box == separate[0].box
+
+
+def _pool_scene() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(photo, body, lower part, pool) at detection scale: a dark vessel with sharp edges on a grey sweep, its
+    lower part (stem and foot) as dark, and a soft pool of light on the floor centred under it (all H x W)."""
+    h = w = 320
+    yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+    pool = 55.0 * np.exp(-(((xx - w / 2) / (0.42 * w)) ** 2 + ((yy - 0.86 * h) / (0.12 * h)) ** 2))
+    body = np.zeros((h, w), np.uint8)
+    cv2.ellipse(body, (w // 2, 150), (75, 85), 0, 0, 360, 1, -1)
+    cv2.rectangle(body, (w // 2 - 35, 50), (w // 2 + 35, 100), 1, -1)  # neck
+    cv2.rectangle(body, (w // 2 - 55, 45), (w // 2 + 55, 56), 1, -1)  # rim
+    lower = np.zeros((h, w), np.uint8)
+    cv2.rectangle(lower, (w // 2 - 20, 230), (w // 2 + 20, 250), 1, -1)  # stem
+    cv2.rectangle(lower, (w // 2 - 45, 250), (w // 2 + 45, 270), 1, -1)  # foot
+    grey = np.where((body | lower) > 0, 40.0, 95.0 + 35.0 * yy / h + pool)
+    return np.repeat(grey.astype(np.uint8)[..., None], 3, axis=2), body > 0, lower > 0, pool > 20.0
+
+
+@pytest.mark.parametrize("extra", ["pool", "lower part"])
+def test_a_symmetric_growth_counts_only_on_the_photos_edges(extra):
+    """The strict reading wins where it adds a symmetric part the forgiving one took for shade: the vessel's
+    dark lower part, whose outline is an edge in the photo; not where it adds the floor's pool of light under
+    the vessel, as symmetric but with no edge (a greyscale photo, where the pale foot and the lit floor are one
+    grey)."""
+    from radar_cli.masks import detect as detection
+
+    photo, body, lower, pool = _pool_scene()
+    forgiving = body if extra == "lower part" else body | lower
+    strict = forgiving | (lower if extra == "lower part" else pool)
+    evidence = np.zeros(body.shape, np.float32)
+    kept = detection._best_reading(photo, lambda shading: (evidence, forgiving if shading else strict), 0.0,
+                                   lambda: strict)[1]
+    assert np.array_equal(kept, strict if extra == "lower part" else forgiving)
+
+
+def test_a_greyscale_photo_is_located_without_the_lit_floor(shared_data):
+    """A krater's greyscale photograph: the lit floor under its foot is the foot's grey, and the reading that
+    counts every brightness change takes it in, symmetric about the axis; the object found is the one of the
+    colour photograph."""
+    from radar_cli.fileio import read_image
+    from radar_cli.masks import detect as detection
+
+    photo = read_image(shared_data("data", "cva10", "photos", "83AE255", "back.jpg"))
+    luma = photo.astype(np.float32) @ np.array([0.299, 0.587, 0.114], np.float32)
+    grey = np.repeat(np.clip(luma, 0, 255).astype(np.uint8)[..., None], 3, axis=2)
+    colour, plate = detection.detect(photo, thorough=True)[0], detection.detect(grey, thorough=True)[0]
+    assert abs(int(plate.mask.sum()) / int(colour.mask.sum()) - 1.0) < 0.05  # with the floor: 1.34
+    assert plate.box[2] - plate.box[0] < 0.95 * photo.shape[1]
