@@ -4,6 +4,7 @@ reader, failures, resuming and --overwrite."""
 from __future__ import annotations
 
 import csv
+import io
 import json
 from pathlib import Path
 
@@ -15,6 +16,7 @@ from click.testing import CliRunner
 from PIL import Image
 
 from radar_cli.cli import cli
+from radar_cli.derender.export.mesh import OBJ_HEADER, OBJ_MTL, TEXTURE_PNG, glb_texture
 from radar_cli.derender.export.object_folder import ExportConfig
 from radar_cli.derender.run.batch import DerenderOptions, derender
 from radar_cli.derender.run.predictor import Predictor
@@ -84,6 +86,24 @@ def test_meshes_load_with_texture(results: Path) -> None:
     obj = trimesh.load(folder / "mesh.obj")
     assert len(obj.faces) == len(mesh.faces)
     assert obj.visual.material.image.size == texture.size
+
+
+def test_the_obj_texture_and_material_are_trimesh_s(results: Path) -> None:
+    """albedo.png is the PNG inside mesh.glb (encoded once), and it and mesh.mtl are the bytes trimesh's OBJ
+    exporter writes for that texture and material."""
+    folder = results / "square"
+    png = (folder / "albedo.png").read_bytes()
+    assert png == glb_texture((folder / "mesh.glb").read_bytes())
+    obj = trimesh.load(folder / "mesh.obj")
+    texture = Image.open(io.BytesIO(png))
+    texture.encoderinfo = dict(TEXTURE_PNG)
+    texture.format = None  # as build_mesh's image from an array
+    material = obj.visual.material
+    files, name = trimesh.visual.material.SimpleMaterial(
+        name="albedo", image=texture, diffuse=material.diffuse, ambient=material.ambient,
+        specular=material.specular, glossiness=material.glossiness).to_obj(name="albedo")
+    assert files["albedo.png"] == png
+    assert (folder / OBJ_MTL).read_bytes() == f"# {OBJ_HEADER}\n\n".encode() + files[f"{name}.mtl"]
 
 
 def test_crop_box_recorded(results: Path) -> None:

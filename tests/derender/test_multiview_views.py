@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import io
 import json
-import struct
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +14,7 @@ import pytest
 import torch
 from PIL import Image
 
+from radar_cli.derender.export import mesh
 from radar_cli.derender.export.object_folder import ExportConfig
 from radar_cli.derender.multiview.fit import ViewFit
 from radar_cli.derender.multiview.pictures import VIEW_TILE, picture_names
@@ -97,14 +97,7 @@ def test_the_drawing_shows_the_view_its_own_side_of_the_fused_texture(results: P
 
 def glb_texture(path: Path) -> np.ndarray:
     """The base colour texture embedded in a GLB, H x W x 3 uint8."""
-    data = path.read_bytes()
-    json_length = struct.unpack("<I", data[12:16])[0]
-    gltf = json.loads(data[20 : 20 + json_length])
-    binary = data[20 + json_length + 8 :]
-    texture = gltf["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["index"]
-    view = gltf["bufferViews"][gltf["images"][gltf["textures"][texture]["source"]]["bufferView"]]
-    start = view.get("byteOffset", 0)
-    with Image.open(io.BytesIO(binary[start : start + view["byteLength"]])) as im:
+    with Image.open(io.BytesIO(mesh.glb_texture(path.read_bytes()))) as im:
         return np.asarray(im.convert("RGB"))
 
 

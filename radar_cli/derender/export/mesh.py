@@ -5,8 +5,9 @@ unit) with the object's catalogued height when its size is known."""
 
 from __future__ import annotations
 
+import json
+import struct
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import trimesh
@@ -25,8 +26,9 @@ MAX_SPECULAR_FACTOR = 1.0  # MTL Ks lies in [0, 1]; rho (0..2) is halved and cli
 OBJ_MTL = "mesh.mtl"
 OBJ_HEADER = "https://github.com/mikedh/trimesh"  # the meshes' geometry and materials are trimesh's
 TEXTURE_PNG = {"compress_level": 1}
-"""How trimesh's PNG of the texture (in mesh.glb and beside mesh.obj) is encoded: zlib level 1 took 0.04 CPU s for
-a 1,536 x 512 albedo where Pillow's default took 0.17 s, twice per object; the pixels are the same."""
+"""How trimesh's PNG of the texture in mesh.glb is encoded (and beside mesh.obj, the same bytes taken from the
+GLB): zlib level 1 took 0.04 CPU s for a 1,536 x 512 albedo where Pillow's default took 0.17 s; the pixels are the
+same."""
 
 
 def build_mesh(state: ObjectState, n_cols: int) -> trimesh.Trimesh:
@@ -70,24 +72,35 @@ def write_meshes(folder: Path, state: ObjectState, n_cols: int, height_cm: float
     glb = mesh.export(file_type="glb")
     assert isinstance(glb, bytes)  # a binary format
     write_bytes(folder / MESH_GLB_FILE, glb)
-    material: Any = mesh.visual.material  # type: ignore[union-attr]  # build_mesh's TextureVisuals and PBRMaterial
     # OBJ/MTL is Phong: white Kd so viewers show the texture as is, Ns = shininess, Ks from the specular albedo
     spec = int(round(255 * min(float(state.material.rho[0]) / 2.0, MAX_SPECULAR_FACTOR)))
     phong = trimesh.visual.material.SimpleMaterial(
-        name="albedo", image=material.baseColorTexture, diffuse=(255, 255, 255, 255),
-        ambient=(255, 255, 255, 255), specular=(spec, spec, spec, 255), glossiness=float(state.material.alpha[0]))
-    phong.image.encoderinfo = dict(TEXTURE_PNG)
-    files, name = phong.to_obj(name=Path(ALBEDO_FILE).stem)  # the texture and its Phong material
-    mtl = files.pop(f"{name}.mtl")
-    if ALBEDO_FILE not in files:
-        raise OSError(f"the OBJ exporter named the texture {sorted(files)!r}, not {ALBEDO_FILE}")
-    files[OBJ_MTL] = f"# {OBJ_HEADER}\n\n".encode() + mtl
-    for file_name, data in files.items():
-        if Path(file_name).name != file_name:  # trimesh names these; never write outside the folder
-            raise OSError(f"unexpected texture file name from the OBJ exporter: {file_name!r}")
-        write_bytes(folder / file_name, data)
+        name="albedo", diffuse=(255, 255, 255, 255), ambient=(255, 255, 255, 255),
+        specular=(spec, spec, spec, 255), glossiness=float(state.material.alpha[0]))
+    files, name = phong.to_obj(name=Path(ALBEDO_FILE).stem)  # the Phong material, its texture named below
+    mtl = files.pop(f"{name}.mtl") + f"\nmap_Kd {ALBEDO_FILE}".encode()
+    write_bytes(folder / OBJ_MTL, f"# {OBJ_HEADER}\n\n".encode() + mtl)
+    write_bytes(folder / ALBEDO_FILE, glb_texture(glb))  # the PNG trimesh encoded for the GLB, not encoded again
     write_bytes(folder / MESH_OBJ_FILE, obj_text(mesh.vertices, mesh.visual.uv, mesh.faces, name))  # type: ignore[union-attr]
     return real
+
+
+def glb_texture(glb: bytes) -> bytes:
+    """The PNG of a GLB's first image (its buffer view, less the zeros that pad it to four bytes), as the glTF
+    2.0 binary layout has it: a 12-byte header, then chunks of (length, type, data), JSON first, then BIN."""
+    chunks, offset = {}, 12
+    while offset + 8 <= len(glb):
+        length, kind = struct.unpack_from("<I4s", glb, offset)
+        chunks[kind] = glb[offset + 8 : offset + 8 + length]
+        offset += 8 + length
+    gltf = json.loads(chunks[b"JSON"])
+    view = gltf["bufferViews"][gltf["images"][0]["bufferView"]]
+    start = view.get("byteOffset", 0)
+    data = chunks[b"BIN\x00"][start : start + view["byteLength"]]
+    end = data.rfind(b"IEND")  # a PNG ends with its IEND chunk: the type, then a 4-byte CRC
+    if not data.startswith(b"\x89PNG") or end < 0:
+        raise OSError("the GLB's texture is not a PNG")
+    return data[: end + 8]
 
 
 def _lines(line: str, values: np.ndarray) -> str:
