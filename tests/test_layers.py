@@ -13,7 +13,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "radar_cli"
 # lowest first; a module may import from its own layer's package or any layer listed before it
 LAYERS: list[set[str]] = [
     {"errors", "checks", "config", "fileio", "threads", "blas_threads", "distributed", "allocator",
-     "process_memory", "dataset", "results", "sizes", ""},
+     "process_memory", "dataset", "results", "sizes", "catalogue_terms", ""},
     {"harvest"},
     {"sor"},
     {"render"},

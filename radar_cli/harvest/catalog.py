@@ -299,7 +299,7 @@ def stored_size(text: str | None) -> ObjectSize | None:
         return None
 
 
-PHOTO_COLUMNS = ("object_id", "title", "credit_line", "licence", "object_url", "size")
+PHOTO_COLUMNS = ("object_id", "title", "object_name", "credit_line", "licence", "object_url", "size")
 CATALOG_DEPTH = 4  # a photo lies at most this many folders below its harvest folder (met/<id>/<id>_1.jpg: 2)
 
 

@@ -201,10 +201,10 @@ def test_parallel_exports_write_the_same_bytes_and_keep_going_past_a_failure(tmp
         write_photo(tmp_path / "in" / f"{name}.png", 10 + i)
     real = batch.export_object
 
-    def failing_c(folder, *args):
+    def failing_c(folder, *args, **kwargs):
         if folder.name == "c":
             raise OSError("disk full")
-        return real(folder, *args)
+        return real(folder, *args, **kwargs)
 
     monkeypatch.setattr(batch, "export_object", failing_c)
     runs = {}

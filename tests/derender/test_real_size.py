@@ -13,6 +13,8 @@ from click.testing import CliRunner
 from radar_cli.cli import cli
 from radar_cli.derender.export.object_folder import ExportConfig
 from radar_cli.derender.run.batch import DerenderOptions, derender
+from radar_cli.derender.run.inputs import InputItem
+from radar_cli.derender.run.object_record import ObjectRecord, RecordFinder
 from radar_cli.errors import InputError
 from radar_cli.harvest.catalog import open_catalog
 from radar_cli.sizes import read_size_table
@@ -123,3 +125,39 @@ def test_cli_dimensions_bad_table_is_one_line(tmp_path, fake_checkpoint):
                                       "--views", "0", "--view-size", "32", "--dimensions", str(table)])
     assert result.exit_code == 0, result.output
     assert glb_height_cm(tmp_path / "out" / "a") == pytest.approx(20.0, rel=0.01)
+
+
+def test_a_harvested_fragment_is_sent_to_review_by_its_title(tmp_path, predictor):
+    """The record's title says what the photograph may not show: a fragment is `review` with the catalogue's
+    words; a whole vessel's title adds nothing."""
+    data = tmp_path / "data"
+    with open_catalog(data) as catalog:
+        catalog.add_searched([8, 9])
+        for object_id, title in ((8, "Terracotta fragment of a kylix (drinking cup)"),
+                                 (9, "Terracotta oinochoe: chous (jug)")):
+            catalog.set_record(object_id, {"objectID": object_id, "isPublicDomain": True, "title": title,
+                                           "objectName": "Kylix fragment" if object_id == 8 else "Chous"},
+                               f"met/{object_id}.json", f"https://x/{object_id}.jpg", "record")
+            catalog.set_image(object_id, f"met/{object_id}.jpg", 1, "", "")
+            write_photo(data / "met" / f"{object_id}.jpg", object_id)
+    out = tmp_path / "out"
+    derender([data / "met"], predictor, DerenderOptions(out=out, export=EXPORT, resolution=SIZE))
+    fragment, jug = material(out / "8")["quality"], material(out / "9")["quality"]
+    assert fragment["status"] == "review" and fragment["catalogue_kind"] == "a fragment"
+    assert ("the catalogue calls it 'Terracotta fragment of a kylix (drinking cup) / Kylix fragment': a fragment, "
+            "not one whole turned vessel") in fragment["reasons"]
+    assert "catalogue_kind" not in jug and not any("catalogue" in r for r in jug["reasons"])
+
+
+def test_a_crop_from_radar_masks_is_described_by_its_meta(tmp_path):
+    """A crop `radar masks` wrote carries its record's title in meta.json; an oversized or broken one is ignored."""
+    photo = tmp_path / "met_5" / "image.png"
+    write_photo(photo, 1)
+    meta = photo.parent / "meta.json"
+    meta.write_text(json.dumps({"attribution": {"title": "Glass double head-shaped flask",
+                                                "size": {"height_cm": 9.5, "status": "ok"}}}))
+    with RecordFinder() as records:
+        found = records.find(InputItem("met_5", photo))
+        assert found.description == "Glass double head-shaped flask" and found.size.height_cm == 9.5
+        meta.write_text("{not json")
+        assert records.find(InputItem("met_5", photo)) == ObjectRecord()

@@ -46,7 +46,8 @@ def is_complete(folder: Path) -> bool:
 def export_object(folder: Path, item: InputItem, prepared: Prepared, state: ObjectState, setup: ModelConfig,
                   version: str, envs: dict[str, np.ndarray], config: ExportConfig = ExportConfig(),
                   albedo_source: AlbedoSource = "network", pitch_source: PitchSource = "network",
-                  refine: dict | None = None, size: ObjectSize | None = None, extra: dict | None = None) -> dict:
+                  refine: dict | None = None, size: ObjectSize | None = None, extra: dict | None = None,
+                  description: str = "") -> dict:
     """Write all files of one object; image-space outputs at the output side N = prepared.side.
 
     Args:
@@ -63,6 +64,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         size: the object's catalogued size, if known (meshes in metres at its height); one without a height
             leaves them unitless and says why in material.json.
         extra: more entries for material.json (an object with several views: derender.multiview.driver).
+        description: the object's catalogue description (its harvested record's title), read by the status.
 
     Returns:
         The material.json record.
@@ -93,7 +95,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         "pitch_source": pitch_source,
         **({"refine": refine} if refine is not None else {}),
         "environments": sorted(envs),
-        "quality": assess_drawn(prepared, drawing),
+        "quality": assess_drawn(prepared, drawing, description=description),
         **size_record(size, real),
         **(extra or {}),
     })

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from radar_cli.catalogue_terms import not_a_whole_vessel
 from radar_cli.derender.export.faces import face_score
 from radar_cli.derender.export.likeness import (
     colour_shift,
@@ -250,6 +251,9 @@ def judge(record: dict, limits: QualityLimits = QualityLimits()) -> tuple[str, l
     elif limits.review_cut_sides and {"left", "right"} <= set(record.get("cut_edges", [])):
         review.append("the photo's frame cuts off both sides of the object: its full width is not seen")
     review += locating_reasons(record, limits)
+    if record.get("catalogue_kind"):
+        review.append(f"the catalogue calls it '{record.get('catalogue')}': {record['catalogue_kind']}, not one "
+                      "whole turned vessel")
     if failed:
         return "failed", failed + review
     return ("review", review) if review else ("ok", [])
@@ -340,14 +344,20 @@ def assess(prepared: Prepared, state: ObjectState, limits: QualityLimits = Quali
     return assess_drawn(prepared, input_drawing(view, shading, view.draw(shading)), limits)
 
 
-def assess_drawn(prepared: Prepared, drawing: InputDrawing, limits: QualityLimits = QualityLimits()) -> dict:
+def assess_drawn(prepared: Prepared, drawing: InputDrawing, limits: QualityLimits = QualityLimits(),
+                 description: str = "") -> dict:
     """The `quality` record from the object drawn in the input view: its scores, status and reasons.
 
     Args:
         prepared: the input crop and its located silhouette.
         drawing: the final de-rendered object drawn in the input view.
         limits: the thresholds.
+        description: the object's catalogue description ('' unknown): `catalogue_kind` where it names something
+            other than one whole turned vessel (catalogue_terms.not_a_whole_vessel).
     """
     record = scores(prepared, drawing)
+    kind = not_a_whole_vessel(description) if description else None
+    if kind is not None:
+        record.update(catalogue=description, catalogue_kind=kind)
     status, reasons = judge(record, limits)
     return {"status": status, "reasons": reasons, **record}

@@ -112,9 +112,11 @@ def fit_views(item: InputItem, predictor: Predictor, crop: CropMode, backdrop: B
 
 def derender_views(item: InputItem, predictor: Predictor, out: Path, crop: CropMode, backdrop: Backdrop,
                    resolution: Resolution, envs: dict[str, np.ndarray], export: ExportConfig,
-                   say: Callable[[str], None], size: ObjectSize | None = None, workers: int = 1) -> list[Failure]:
-    """De-render one multi-view object into out/<name>/ (at its catalogued size if known, as export_object), its
-    views read and fitted `workers` at a time; returns the photos left out unread (the object is done).
+                   say: Callable[[str], None], size: ObjectSize | None = None, description: str = "",
+                   workers: int = 1) -> list[Failure]:
+    """De-render one multi-view object into out/<name>/ (at its catalogued size if known, its status read with
+    its catalogue description, as export_object), its views read and fitted `workers` at a time; returns the
+    photos left out unread (the object is done).
 
     Raises:
         RadarError, ValueError, RuntimeError, OSError: the object could not be de-rendered.
@@ -131,5 +133,5 @@ def derender_views(item: InputItem, predictor: Predictor, out: Path, crop: CropM
     assert first.report is not None
     export_object(folder, InputItem(item.name, Path(first.source)), first.crops, object_state(fit, predictor),
                   predictor.setup, predictor.version, envs, export, "divided", predictor.pitch, first.report.record(),
-                  size=size, extra=views_record(fit, pictures))
+                  size=size, description=description, extra=views_record(fit, pictures))
     return failures

@@ -41,7 +41,7 @@ from radar_cli.derender.run.inputs import (
     output_side,
     prepare,
 )
-from radar_cli.derender.run.object_size import SizeFinder
+from radar_cli.derender.run.object_record import ObjectRecord, RecordFinder
 from radar_cli.derender.run.predictor import Predictor
 from radar_cli.derender.run.processes import spread
 from radar_cli.derender.run.shard import Shard, read_share_failures, write_share_failures
@@ -190,7 +190,7 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
     output_side(options.resolution, 1)  # checks it before any work
     render = predictor.setup.render
     envs = environments(options.envs, render.env_height, render.env_width)
-    sizes = SizeFinder(options.dimensions)  # a bad table stops the run before any work
+    records = RecordFinder(options.dimensions)  # a bad table stops the run before any work
     items, failures = collect(inputs, options)
     shard = options.shard
     if options.out.is_dir():  # what a killed run was writing: the report, the gallery, finished objects
@@ -201,12 +201,12 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
     options.out.mkdir(parents=True, exist_ok=True)
     batches = shard.blocks([i for i in items if not i.multiview], options.batch_size)
     several = [block[0] for block in shard.blocks([i for i in items if i.multiview], 1)]
-    with sizes, torch_threads(options.threads), tqdm(total=sum(map(len, batches)) + len(several), desc="derender",
+    with records, torch_threads(options.threads), tqdm(total=sum(map(len, batches)) + len(several), desc="derender",
                                                      unit="obj", disable=None) as bar:
         if options.processes and options.workers > 1 and predictor.device.type == "cpu":
-            _on_processes(batches, several, predictor, options, envs, summary, say, sizes, bar)
+            _on_processes(batches, several, predictor, options, envs, summary, say, records, bar)
         else:
-            _on_threads(batches, several, predictor, options, envs, summary, say, sizes, bar)
+            _on_threads(batches, several, predictor, options, envs, summary, say, records, bar)
     if shard.enabled:
         write_share_failures(options.out, shard, summary.failures)
     if report:
@@ -218,9 +218,9 @@ def derender(inputs: list[str | Path], predictor: Predictor, options: DerenderOp
 
 def _on_threads(batches: list[list[InputItem]], several: list[InputItem], predictor: Predictor,
                 options: DerenderOptions, envs: dict[str, np.ndarray], summary: BatchSummary,
-                say: Callable[[str], None], sizes: SizeFinder, bar: tqdm) -> None:
+                say: Callable[[str], None], records: RecordFinder, bar: tqdm) -> None:
     """The batches through one pool of options.workers threads, then the multi-view objects one by one."""
-    runner = _Batches(predictor, options, envs, summary, say, sizes, bar)
+    runner = _Batches(predictor, options, envs, summary, say, records, bar)
     try:
         for batch in batches:
             runner.run(batch, _pending(batch, options.out, options.overwrite, summary, say))
@@ -229,7 +229,7 @@ def _on_threads(batches: list[list[InputItem]], several: list[InputItem], predic
         runner.pool.close()
     for item in several:
         if _pending([item], options.out, options.overwrite, summary, say):
-            _run_views(item, predictor, options, envs, summary, say, sizes)
+            _run_views(item, predictor, options, envs, summary, say, records)
         bar.update(1)
 
 
@@ -252,7 +252,7 @@ class _Outcome:
 
 def _on_processes(batches: list[list[InputItem]], several: list[InputItem], predictor: Predictor,
                   options: DerenderOptions, envs: dict[str, np.ndarray], summary: BatchSummary,
-                  say: Callable[[str], None], sizes: SizeFinder, bar: tqdm) -> None:
+                  say: Callable[[str], None], records: RecordFinder, bar: tqdm) -> None:
     """Every object still to do as a task for options.workers processes (this one and workers - 1 spawned ones,
     each given the model and options pickled); outcomes recorded in input order, said as they come."""
     tasks = []
@@ -278,7 +278,7 @@ def _on_processes(batches: list[list[InputItem]], several: list[InputItem], pred
         return _Outcome([], [failure], [failure.line()])
 
     payload = pickle.dumps((predictor, one, envs))  # for our own worker processes only: never written to disk
-    outcomes = spread(tasks, functools.partial(_run_task, predictor=predictor, options=one, envs=envs, sizes=sizes),
+    outcomes = spread(tasks, functools.partial(_run_task, predictor=predictor, options=one, envs=envs, records=records),
                       functools.partial(_process_worker, payload), options.workers - 1, arrived, lost)
     for outcome in outcomes:
         summary.done += outcome.done
@@ -291,19 +291,19 @@ def _process_worker(payload: bytes) -> Callable[[_Task], _Outcome]:
     keep_freed_memory()
     predictor, options, envs = pickle.loads(payload)  # made by the run's own process, passed by a pipe
     torch.set_num_threads(options.threads)
-    sizes = SizeFinder(options.dimensions)  # open for the process's life: its catalogs' connections are its own
-    return functools.partial(_run_task, predictor=predictor, options=options, envs=envs, sizes=sizes)
+    records = RecordFinder(options.dimensions)  # open for the process's life: its catalogs' connections are its own
+    return functools.partial(_run_task, predictor=predictor, options=options, envs=envs, records=records)
 
 
 def _run_task(task: _Task, predictor: Predictor, options: DerenderOptions, envs: dict[str, np.ndarray],
-              sizes: SizeFinder) -> _Outcome:
+              records: RecordFinder) -> _Outcome:
     """De-render one object in this process (options.workers 1)."""
     summary = BatchSummary()
     said: list[str] = []
     if task.views:
-        _run_views(task.item, predictor, options, envs, summary, said.append, sizes)
+        _run_views(task.item, predictor, options, envs, summary, said.append, records)
     else:
-        runner = _Batches(predictor, options, envs, summary, said.append, sizes, None)
+        runner = _Batches(predictor, options, envs, summary, said.append, records, None)
         runner.run([task.item], {task.item.name})
         runner.finish()
     return _Outcome(summary.done, summary.failures, said)
@@ -316,9 +316,9 @@ class _Batches:
     first; each object's files are the same bytes as a one-worker run's (every export on one torch thread)."""
 
     def __init__(self, predictor: Predictor, options: DerenderOptions, envs: dict[str, np.ndarray],
-                 summary: BatchSummary, say: Callable[[str], None], sizes: SizeFinder, bar: tqdm | None):
+                 summary: BatchSummary, say: Callable[[str], None], records: RecordFinder, bar: tqdm | None):
         self.predictor, self.options, self.envs, self.summary, self.say = predictor, options, envs, summary, say
-        self.sizes, self.bar = sizes, bar
+        self.records, self.bar = records, bar
         self.pool = _Pool(options.workers)
         self.exporting: list[tuple[InputItem, Future[Failure | None]]] = []  # the batch before, in input order
         self.size_of_exporting = 0  # its inputs, skipped ones included (the progress bar's steps)
@@ -333,7 +333,7 @@ class _Batches:
         exports = []
         if ok:
             dec = self.predictor.predict([prep.image for _, prep in ok], [prep.silhouette for _, prep in ok])
-            found = [self.sizes.find(item) for item, _ in ok]  # here: this thread holds the catalogs' connections
+            found = [self.records.find(item) for item, _ in ok]  # here: this thread holds the catalogs' connections
             exports = [(item, self.pool.submit(self._export_one, item, prep, dec.select(k), found[k]))
                        for k, (item, prep) in enumerate(ok)]
         self.finish()
@@ -357,7 +357,7 @@ class _Batches:
         self.exporting, self.size_of_exporting = [], 0
 
     def _export_one(self, item: InputItem, prep: Prepared, dec: Decomposition,
-                    found: ObjectSize | None) -> Failure | None:
+                    found: ObjectRecord) -> Failure | None:
         """Refine and export one predicted object (batch of one `dec`); an error costs this object only."""
         predictor = self.predictor
         assert prep.photo_image is not None  # Prepared sets it
@@ -367,7 +367,8 @@ class _Batches:
                 self.say(f"{item.image_path}: refinement fell back to the network's prediction: {report.reason}")
             state = full_resolution_state(refined, prep, predictor.setup, predictor.albedo)
             export_object(self.options.out / item.name, item, prep, state, predictor.setup, predictor.version,
-                          self.envs, self.options.export, predictor.albedo, predictor.pitch, report.record(), found)
+                          self.envs, self.options.export, predictor.albedo, predictor.pitch, report.record(),
+                          found.size, description=found.description)
         except ITEM_ERRORS as e:
             return Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
         return None
@@ -381,14 +382,20 @@ def _prepare_one(item: InputItem, size: int, options: DerenderOptions) -> Prepar
         return Failure(str(item.image_path), str(e).removeprefix(f"{item.image_path}: "))
 
 
+def _record(records: RecordFinder, item: InputItem) -> tuple[ObjectSize | None, str]:
+    """(size, description) of a multi-view object, from its catalogue record."""
+    found = records.find(item)
+    return found.size, found.description
+
+
 def _run_views(item: InputItem, predictor: Predictor, options: DerenderOptions, envs: dict[str, np.ndarray],
-               summary: BatchSummary, say: Callable[[str], None], sizes: SizeFinder) -> None:
+               summary: BatchSummary, say: Callable[[str], None], records: RecordFinder) -> None:
     """One object photographed from several sides (derender.multiview.driver); its unreadable photos are recorded
     as failures, the object is done with the others."""
     try:
         with torch_threads(EXPORT_THREADS):
             left_out = derender_views(item, predictor, options.out, options.crop, options.backdrop,
-                                      options.resolution, envs, options.export, say, sizes.find(item),
+                                      options.resolution, envs, options.export, say, *_record(records, item),
                                       options.workers)
     except ITEM_ERRORS as e:
         failure = Failure(str(item.image_path.parent), f"multi-view object failed ({type(e).__name__}: {e})")

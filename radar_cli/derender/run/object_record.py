@@ -1,0 +1,82 @@
+"""What the catalogue says of each input: its real size, from `radar derender --dimensions FILE` first, else from
+the harvest the photo came from (the meta.json `radar masks` wrote beside it, or the catalog of the `radar fetch`
+folder it lies in); and from that harvest its description (the record's title and object name)."""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from dataclasses import dataclass
+from pathlib import Path
+
+from radar_cli.derender.run.inputs import InputItem
+from radar_cli.harvest.catalog import photo_row, stored_size
+from radar_cli.sizes import ObjectSize, SizeTable, read_size_table
+
+META_FILE = "meta.json"
+MAX_META_BYTES = 1024 * 1024  # meta.json beside an input is untrusted: refuse larger files
+MAX_DESCRIPTION = 500  # characters of a record's title and object name kept
+
+
+@dataclass(frozen=True)
+class ObjectRecord:
+    """What the catalogue says of one input.
+
+    Attributes:
+        size: its catalogued size (None: no table row or harvested record knows the object).
+        description: its harvested record's title and object name ('' where none is known).
+    """
+
+    size: ObjectSize | None = None
+    description: str = ""
+
+
+class RecordFinder:
+    """Looks inputs up in the dimensions table and their harvests (one thread: it holds the catalogs'
+    connections; close it after use).
+
+    Args:
+        table: the --dimensions file, or None.
+    """
+
+    def __init__(self, table: Path | None = None):
+        self.table: SizeTable | None = read_size_table(table) if table is not None else None
+        self.catalogs: dict[Path, sqlite3.Connection] = {}
+
+    def close(self) -> None:
+        """Close the catalogs opened."""
+        for db in self.catalogs.values():
+            db.close()
+        self.catalogs.clear()
+
+    def __enter__(self) -> "RecordFinder":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def find(self, item: InputItem) -> ObjectRecord:
+        """The item's size (the table's row for its name or folder, else its harvested record's, which may say
+        `none` or `ambiguous`) and its harvested record's description."""
+        harvested = self._harvested(item.image_path)
+        size = self.table.lookup(item.name, item.image_path) if self.table is not None else None
+        if harvested is None:
+            return ObjectRecord(size)
+        found = stored_size(harvested["size"]) if isinstance(harvested.get("size"), str) else (
+            ObjectSize.from_dict(harvested.get("size")))
+        words = (harvested.get(key) for key in ("title", "object_name"))
+        description = " / ".join(str(w).strip() for w in words if isinstance(w, str) and w.strip())
+        return ObjectRecord(size if size is not None else found, description[:MAX_DESCRIPTION])
+
+    def _harvested(self, photo: Path) -> dict | None:
+        """The input's harvested record (meta.json's attribution, or its catalog row), None if it has none."""
+        meta = photo.parent / META_FILE
+        try:
+            if meta.is_file():
+                if meta.stat().st_size > MAX_META_BYTES:
+                    return None
+                found = json.loads(meta.read_text("utf-8")).get("attribution")
+                return found if isinstance(found, dict) else None
+            return photo_row(photo, self.catalogs)
+        except (OSError, ValueError, AttributeError, sqlite3.Error):
+            return None
