@@ -9,7 +9,7 @@ from __future__ import annotations
 import csv
 import io
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
@@ -19,6 +19,9 @@ SizeStatus = Literal["ok", "none", "ambiguous"]
 ID_COLUMNS = ("object", "object_id", "id")
 HEIGHT_COLUMN = "height_cm"
 DIAMETER_COLUMNS = {"rim_cm": "rim_cm", "body_cm": "body_cm", "foot_cm": "foot_cm", "diameter_cm": "diameter_cm"}
+DESCRIPTION_COLUMNS = ("title", "object_name", "kind", "shape", "classification")
+"""Columns whose words describe the object (joined with ' / '), read by the status (catalogue_terms)."""
+MAX_DESCRIPTION = 500  # characters of a description kept
 MAX_TABLE_BYTES = 16 * 1024 * 1024
 MAX_CM = 100_000.0  # 1 km: anything larger is a typo or a unit mix-up
 
@@ -107,25 +110,34 @@ class SizeTable:
 
     path: Path
     sizes: dict[str, ObjectSize]
+    descriptions: dict[str, str] = field(default_factory=dict)
 
     def lookup(self, name: str, photo: Path | None = None) -> ObjectSize | None:
         """The size of the result `name` (`<id>` or `<id>_<view>`, the longest matching id), else of the folder
         the photo lies in (`<id>/<view>.jpg`); None if no id matches."""
         found = self.match(name)
         if found is not None:
-            return self.sizes[found[0]]
+            return self.sizes.get(found[0])
         if photo is not None:
             return self.sizes.get(photo.parent.name.casefold())
         return None
+
+    def describe(self, name: str, photo: Path | None = None) -> str:
+        """The description (DESCRIPTION_COLUMNS) of the object matched as by `lookup`, '' if none."""
+        found = self.match(name)
+        if found is not None:
+            return self.descriptions.get(found[0], "")
+        return self.descriptions.get(photo.parent.name.casefold(), "") if photo is not None else ""
 
 
     def match(self, name: str) -> tuple[str, str] | None:
         """(id key, view) of the result `name`: `<id>` (view '') or `<id>_<view>`, the longest matching id;
         None if none matches."""
         key = name.casefold()
-        if key in self.sizes:
+        known = self.sizes.keys() | self.descriptions.keys()
+        if key in known:
             return key, ""
-        prefixed = [i for i in self.sizes if key.startswith(i + "_")]
+        prefixed = [i for i in known if key.startswith(i + "_")]
         if not prefixed:
             return None
         best = max(prefixed, key=len)
@@ -134,7 +146,7 @@ class SizeTable:
 
 def read_size_table(path: str | Path) -> SizeTable:
     """Read a dimensions table: tab-separated if its header has a tab, else comma-separated; rows without a
-    height (fragments) are left out; other columns are ignored.
+    height (fragments) give no size, their description (DESCRIPTION_COLUMNS) is kept; other columns are ignored.
 
     Raises:
         InputError: unreadable, no id or height_cm column, a bad number, or an id given twice.
@@ -153,6 +165,7 @@ def read_size_table(path: str | Path) -> SizeTable:
     if HEIGHT_COLUMN not in header:
         raise InputError(f"{path}: no {HEIGHT_COLUMN} column in the header")
     sizes: dict[str, ObjectSize] = {}
+    descriptions: dict[str, str] = {}
     for line, row in enumerate(rows[1:], 2):
         if not any(cell.strip() for cell in row):
             continue
@@ -161,13 +174,17 @@ def read_size_table(path: str | Path) -> SizeTable:
         object_id = cells.get(id_column, "").strip()
         if not object_id:
             raise InputError(f"{where}: no object id")
+        if object_id.casefold() in sizes.keys() | descriptions.keys():
+            raise InputError(f"{where}: object {object_id!r} is given twice")
+        words = [cells.get(c, "").strip() for c in DESCRIPTION_COLUMNS]
+        description = " / ".join(w for w in words if w)[:MAX_DESCRIPTION]
+        if description:
+            descriptions[object_id.casefold()] = description
         height = centimetres(cells.get(HEIGHT_COLUMN, ""), where, HEIGHT_COLUMN)
         if height is None:
             continue
-        if object_id.casefold() in sizes:
-            raise InputError(f"{where}: object {object_id!r} is given twice")
         diameters: dict[str, Any] = {field: centimetres(cells.get(col, ""), where, col)
                                      for col, field in DIAMETER_COLUMNS.items()}
         sizes[object_id.casefold()] = ObjectSize(height_cm=height, **diameters, status="ok",
                                                  source=f"table {path.name}")
-    return SizeTable(path, sizes)
+    return SizeTable(path, sizes, descriptions)

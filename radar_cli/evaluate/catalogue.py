@@ -110,7 +110,7 @@ def evaluate_catalogue(results: str | Path, dimensions: str | Path, drawings: st
     for paths in list_results(root):
         name = paths.folder.name
         found = table.match(name)
-        if found is None:
+        if found is None or found[0] not in table.sizes:  # no row, or one without a size (a fragment)
             unmatched.append(name)
             continue
         key, view = found

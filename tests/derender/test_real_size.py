@@ -161,3 +161,20 @@ def test_a_crop_from_radar_masks_is_described_by_its_meta(tmp_path):
         assert found.description == "Glass double head-shaped flask" and found.size.height_cm == 9.5
         meta.write_text("{not json")
         assert records.find(InputItem("met_5", photo)) == ObjectRecord()
+
+
+def test_a_table_row_without_a_size_still_describes_its_object(tmp_path, predictor):
+    """A catalogue table's fragment (no height, kind `fragment`) gives no size but its description: the result
+    is `review` in the catalogue's words; a whole vessel's row adds no such reason."""
+    write_photo(tmp_path / "in" / "86AE203_front.png", 1)
+    write_photo(tmp_path / "in" / "73AE135_front.png", 2)
+    table = tmp_path / "objects.tsv"
+    table.write_text(TABLE.replace("\tkind\t", "\tkind\tshape\t").replace("\twhole\t", "\twhole\tcolumn-krater\t")
+                     .replace("\tfragment\t", "\tfragment\tkrater fragment\t"))
+    assert read_size_table(table).describe("86AE203_front") == "fragment / krater fragment"
+    out = tmp_path / "out"
+    derender([tmp_path / "in"], predictor, DerenderOptions(out=out, export=EXPORT, resolution=SIZE, dimensions=table))
+    fragment, whole = material(out / "86AE203_front"), material(out / "73AE135_front")
+    assert "size_cm" not in fragment and fragment["quality"]["catalogue_kind"] == "a fragment"
+    assert fragment["quality"]["status"] == "review"
+    assert whole["size_cm"]["height"] == 35.0 and "catalogue_kind" not in whole["quality"]

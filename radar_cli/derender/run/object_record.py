@@ -1,6 +1,6 @@
-"""What the catalogue says of each input: its real size, from `radar derender --dimensions FILE` first, else from
-the harvest the photo came from (the meta.json `radar masks` wrote beside it, or the catalog of the `radar fetch`
-folder it lies in); and from that harvest its description (the record's title and object name)."""
+"""What the catalogue says of each input: its real size and its description (title, object name, kind, shape),
+from `radar derender --dimensions FILE` first, else from the harvest the photo came from (the meta.json `radar
+masks` wrote beside it, or the catalog of the `radar fetch` folder it lies in)."""
 
 from __future__ import annotations
 
@@ -24,7 +24,8 @@ class ObjectRecord:
 
     Attributes:
         size: its catalogued size (None: no table row or harvested record knows the object).
-        description: its harvested record's title and object name ('' where none is known).
+        description: its table row's title, object name, kind and shape, or its harvested record's title and
+            object name ('' where none is known).
     """
 
     size: ObjectSize | None = None
@@ -56,17 +57,22 @@ class RecordFinder:
         self.close()
 
     def find(self, item: InputItem) -> ObjectRecord:
-        """The item's size (the table's row for its name or folder, else its harvested record's, which may say
-        `none` or `ambiguous`) and its harvested record's description."""
+        """The item's size and description: the table's row for its name or folder, else its harvested record's
+        (whose size may say `none` or `ambiguous`)."""
+        size, description = None, ""
+        if self.table is not None:
+            size = self.table.lookup(item.name, item.image_path)
+            description = self.table.describe(item.name, item.image_path)
         harvested = self._harvested(item.image_path)
-        size = self.table.lookup(item.name, item.image_path) if self.table is not None else None
         if harvested is None:
-            return ObjectRecord(size)
-        found = stored_size(harvested["size"]) if isinstance(harvested.get("size"), str) else (
-            ObjectSize.from_dict(harvested.get("size")))
-        words = (harvested.get(key) for key in ("title", "object_name"))
-        description = " / ".join(str(w).strip() for w in words if isinstance(w, str) and w.strip())
-        return ObjectRecord(size if size is not None else found, description[:MAX_DESCRIPTION])
+            return ObjectRecord(size, description)
+        if size is None:
+            size = stored_size(harvested["size"]) if isinstance(harvested.get("size"), str) else (
+                ObjectSize.from_dict(harvested.get("size")))
+        if not description:
+            words = (harvested.get(key) for key in ("title", "object_name"))
+            description = " / ".join(w.strip() for w in words if isinstance(w, str) and w.strip())[:MAX_DESCRIPTION]
+        return ObjectRecord(size, description)
 
     def _harvested(self, photo: Path) -> dict | None:
         """The input's harvested record (meta.json's attribution, or its catalog row), None if it has none."""
