@@ -149,7 +149,8 @@ def read_size_table(path: str | Path) -> SizeTable:
     height (fragments) give no size, their description (DESCRIPTION_COLUMNS) is kept; other columns are ignored.
 
     Raises:
-        InputError: unreadable, no id or height_cm column, a bad number, or an id given twice.
+        InputError: unreadable, no id column, neither a height_cm nor a description column, a bad number, or an
+            id given twice.
     """
     path = Path(path)
     try:
@@ -162,8 +163,8 @@ def read_size_table(path: str | Path) -> SizeTable:
     rows = list(csv.reader(io.StringIO(text), delimiter="\t" if "\t" in first else ","))
     header = [h.strip().casefold() for h in rows[0]] if rows else []
     id_column = _id_column(header, path)
-    if HEIGHT_COLUMN not in header:
-        raise InputError(f"{path}: no {HEIGHT_COLUMN} column in the header")
+    if HEIGHT_COLUMN not in header and not set(DESCRIPTION_COLUMNS) & set(header):
+        raise InputError(f"{path}: no {HEIGHT_COLUMN} column (nor {', '.join(DESCRIPTION_COLUMNS)}) in the header")
     sizes: dict[str, ObjectSize] = {}
     descriptions: dict[str, str] = {}
     for line, row in enumerate(rows[1:], 2):

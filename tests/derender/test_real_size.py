@@ -106,6 +106,12 @@ def test_table_is_read_strictly(tmp_path):
     path.write_text("name,height\nA,12\n")
     with pytest.raises(InputError, match="no object id column"):
         read_size_table(path)
+    path.write_text("id,height\nA,12\n")
+    with pytest.raises(InputError, match=r"sizes.csv: no height_cm column \(nor title, object_name"):
+        read_size_table(path)
+    path.write_text("id,title\nA,Terracotta head vase\n")  # a table of titles alone describes, sizes nothing
+    titles = read_size_table(path)
+    assert titles.lookup("A") is None and titles.describe("A_front") == "Terracotta head vase"
     path.write_text("id,height_cm,rim_cm\nA,12.5,\nA_1,20,4\n")
     table = read_size_table(path)
     assert table.lookup("a").height_cm == 12.5 and table.lookup("A_1_front").height_cm == 20  # longest id
