@@ -27,10 +27,10 @@ from radar_cli.derender.run.inputs import (
     resize_image,
     resize_mask,
 )
+from radar_cli.derender.run.object_record import ObjectRecord
 from radar_cli.derender.run.predictor import Predictor
 from radar_cli.errors import InputError, RadarError
 from radar_cli.results import COVERAGE_FILE, MATERIAL_FILE
-from radar_cli.sizes import ObjectSize
 from radar_cli.threads import thread_map
 
 
@@ -112,8 +112,8 @@ def fit_views(item: InputItem, predictor: Predictor, crop: CropMode, backdrop: B
 
 def derender_views(item: InputItem, predictor: Predictor, out: Path, crop: CropMode, backdrop: Backdrop,
                    resolution: Resolution, envs: dict[str, np.ndarray], export: ExportConfig,
-                   say: Callable[[str], None], size: ObjectSize | None = None, description: str = "",
-                   workers: int = 1) -> list[Failure]:
+                   say: Callable[[str], None], record: ObjectRecord = ObjectRecord(), workers: int = 1
+                   ) -> list[Failure]:
     """De-render one multi-view object into out/<name>/ (at its catalogued size if known, its status read with
     its catalogue description, as export_object), its views read and fitted `workers` at a time; returns the
     photos left out unread (the object is done).
@@ -133,5 +133,5 @@ def derender_views(item: InputItem, predictor: Predictor, out: Path, crop: CropM
     assert first.report is not None
     export_object(folder, InputItem(item.name, Path(first.source)), first.crops, object_state(fit, predictor),
                   predictor.setup, predictor.version, envs, export, "divided", predictor.pitch, first.report.record(),
-                  size=size, description=description, extra=views_record(fit, pictures))
+                  size=record.size, description=record.description, extra=views_record(fit, pictures))
     return failures

@@ -49,7 +49,6 @@ from radar_cli.derender.run.upsample import full_resolution_state
 from radar_cli.errors import InputError, NothingToDoError, RadarError
 from radar_cli.fileio import remove_stale_temps
 from radar_cli.model.outputs import Decomposition
-from radar_cli.sizes import ObjectSize
 from radar_cli.threads import on_torch_threads, torch_threads
 
 R = TypeVar("R")
@@ -382,12 +381,6 @@ def _prepare_one(item: InputItem, size: int, options: DerenderOptions) -> Prepar
         return Failure(str(item.image_path), str(e).removeprefix(f"{item.image_path}: "))
 
 
-def _record(records: RecordFinder, item: InputItem) -> tuple[ObjectSize | None, str]:
-    """(size, description) of a multi-view object, from its catalogue record."""
-    found = records.find(item)
-    return found.size, found.description
-
-
 def _run_views(item: InputItem, predictor: Predictor, options: DerenderOptions, envs: dict[str, np.ndarray],
                summary: BatchSummary, say: Callable[[str], None], records: RecordFinder) -> None:
     """One object photographed from several sides (derender.multiview.driver); its unreadable photos are recorded
@@ -395,7 +388,7 @@ def _run_views(item: InputItem, predictor: Predictor, options: DerenderOptions, 
     try:
         with torch_threads(EXPORT_THREADS):
             left_out = derender_views(item, predictor, options.out, options.crop, options.backdrop,
-                                      options.resolution, envs, options.export, say, *_record(records, item),
+                                      options.resolution, envs, options.export, say, records.find(item),
                                       options.workers)
     except ITEM_ERRORS as e:
         failure = Failure(str(item.image_path.parent), f"multi-view object failed ({type(e).__name__}: {e})")

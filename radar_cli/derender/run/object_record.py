@@ -63,7 +63,7 @@ class RecordFinder:
         if self.table is not None:
             size = self.table.lookup(item.name, item.image_path)
             description = self.table.describe(item.name, item.image_path)
-        harvested = self._harvested(item.image_path)
+        harvested = None if size is not None and description else self._harvested(item.image_path)
         if harvested is None:
             return ObjectRecord(size, description)
         if size is None:
