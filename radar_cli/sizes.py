@@ -114,20 +114,19 @@ class SizeTable:
 
     def lookup(self, name: str, photo: Path | None = None) -> ObjectSize | None:
         """The size of the result `name` (`<id>` or `<id>_<view>`, the longest matching id), else of the folder
-        the photo lies in (`<id>/<view>.jpg`); None if no id matches."""
-        found = self.match(name)
-        if found is not None:
-            return self.sizes.get(found[0])
-        if photo is not None:
-            return self.sizes.get(photo.parent.name.casefold())
-        return None
+        the photo lies in (`<id>/<view>.jpg`); None if no id matches or its row has no height."""
+        return self.sizes.get(self._key(name, photo))
 
     def describe(self, name: str, photo: Path | None = None) -> str:
         """The description (DESCRIPTION_COLUMNS) of the object matched as by `lookup`, '' if none."""
+        return self.descriptions.get(self._key(name, photo), "")
+
+    def _key(self, name: str, photo: Path | None) -> str:
+        """The id `name` matches, else the folder the photo lies in ('' without a photo)."""
         found = self.match(name)
         if found is not None:
-            return self.descriptions.get(found[0], "")
-        return self.descriptions.get(photo.parent.name.casefold(), "") if photo is not None else ""
+            return found[0]
+        return photo.parent.name.casefold() if photo is not None else ""
 
 
     def match(self, name: str) -> tuple[str, str] | None:
