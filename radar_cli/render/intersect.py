@@ -16,10 +16,11 @@ from dataclasses import dataclass
 import torch
 
 BIG = 1e6  # a parameter far beyond any object (object-space units)
-SEARCH_CHUNK = 32768
+SEARCH_CHUNK = 16384
 """Rays searched at a time on the CPU: a 512 px view's 262k rays cross ~8M (ray, segment) pairs, whose ~15 working
-tensors took 500 MB at once; chunks of 32k rays take ~60 MB. Every ray's search is its own (elementwise operations
-and per-ray minima), so the result is the same bits in chunks or at once."""
+tensors took 500 MB at once; chunks of 16k rays take ~30 MB (with 32k a de-rendering's two worker processes peaked
+140 MiB higher, at the same speed; docs/performance.md). Every ray's search is its own (elementwise operations and
+per-ray minima), so the result is the same bits in chunks or at once."""
 GPU_SEARCH_CHUNK = 1 << 21
 """Rays searched at a time on a GPU (~4 GB of working tensors): a training batch of 24 views at 256 px (1.6M rays)
 in one chunk. In 32k-ray chunks it took 48, each ~350 kernel launches and several host synchronisations, and the
