@@ -90,7 +90,9 @@ RESOLUTION = ResolutionType()
 @click.option("--dimensions", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Table of catalogued sizes (TSV or CSV: an object/id column, height_cm, optional rim_cm, "
                    "body_cm, foot_cm): results named <id> or <id>_<view>, or photos in a folder <id>/, get meshes "
-                   "in metres at that height. Without it a harvested record's size is used where there is one.")
+                   "in metres at that height; its title, object_name, kind or shape columns are read by the status "
+                   "(a fragment, a head vase, a lid: review). Without it a harvested record's size and title are "
+                   "used where there is one.")
 @click.option("--contact-sheet", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Also write a contact sheet PNG (input, reconstruction, albedo, relit view per object).")
 def derender(inputs: tuple[Path, ...], out: Path, checkpoint: Path | None, masks: Path | None, crop: str,
