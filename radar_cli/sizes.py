@@ -11,7 +11,7 @@ import io
 import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Iterable, Literal
 
 from radar_cli.errors import InputError
 
@@ -97,6 +97,13 @@ def centimetres(text: str, where: str, column: str) -> float | None:
     return value
 
 
+def description_of(words: Iterable[object]) -> str:
+    """A catalogue description from its parts (title, object name, kind, ...): the non-empty texts joined with
+    ' / ', at most MAX_DESCRIPTION characters."""
+    texts = (w.strip() for w in words if isinstance(w, str))
+    return " / ".join(t for t in texts if t)[:MAX_DESCRIPTION]
+
+
 def _id_column(header: list[str], path: Path) -> str:
     for name in ID_COLUMNS:
         if name in header:
@@ -176,8 +183,7 @@ def read_size_table(path: str | Path) -> SizeTable:
             raise InputError(f"{where}: no object id")
         if object_id.casefold() in sizes.keys() | descriptions.keys():
             raise InputError(f"{where}: object {object_id!r} is given twice")
-        words = [cells.get(c, "").strip() for c in DESCRIPTION_COLUMNS]
-        description = " / ".join(w for w in words if w)[:MAX_DESCRIPTION]
+        description = description_of(cells.get(c) for c in DESCRIPTION_COLUMNS)
         if description:
             descriptions[object_id.casefold()] = description
         height = centimetres(cells.get(HEIGHT_COLUMN, ""), where, HEIGHT_COLUMN)

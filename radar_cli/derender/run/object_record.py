@@ -11,11 +11,10 @@ from pathlib import Path
 
 from radar_cli.derender.run.inputs import InputItem
 from radar_cli.harvest.catalog import photo_row, stored_size
-from radar_cli.sizes import ObjectSize, SizeTable, read_size_table
+from radar_cli.sizes import ObjectSize, SizeTable, description_of, read_size_table
 
 META_FILE = "meta.json"
 MAX_META_BYTES = 1024 * 1024  # meta.json beside an input is untrusted: refuse larger files
-MAX_DESCRIPTION = 500  # characters of a record's title and object name kept
 
 
 @dataclass(frozen=True)
@@ -70,8 +69,7 @@ class RecordFinder:
             size = stored_size(harvested["size"]) if isinstance(harvested.get("size"), str) else (
                 ObjectSize.from_dict(harvested.get("size")))
         if not description:
-            words = (harvested.get(key) for key in ("title", "object_name"))
-            description = " / ".join(w.strip() for w in words if isinstance(w, str) and w.strip())[:MAX_DESCRIPTION]
+            description = description_of(harvested.get(key) for key in ("title", "object_name"))
         return ObjectRecord(size, description)
 
     def _harvested(self, photo: Path) -> dict | None:
