@@ -156,7 +156,7 @@ def test_a_harvested_fragment_is_sent_to_review_by_its_title(tmp_path, predictor
 
 
 def test_a_crop_from_radar_masks_is_described_by_its_meta(tmp_path):
-    """A crop `radar masks` wrote carries its record's title in meta.json; an oversized or broken one is ignored."""
+    """A crop `radar masks` wrote carries its record's title in meta.json; a broken one is ignored."""
     photo = tmp_path / "met_5" / "image.png"
     write_photo(photo, 1)
     meta = photo.parent / "meta.json"
