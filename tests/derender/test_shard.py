@@ -104,15 +104,22 @@ def _derender_cmd(photos: Path, out: Path, nproc: int) -> list[str]:
     return [sys.executable, "-m", "torch.distributed.run", "--standalone", f"--nproc_per_node={nproc}", *args]
 
 
-def _env() -> dict[str, str]:
-    return dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=str(REPO))
+def _env(scratch: Path) -> dict[str, str]:
+    """The subprocess's environment: one thread, this checkout, and temporary files (torchrun's own log folders)
+    under `scratch`, not left in the system's."""
+    return dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=str(REPO), TMPDIR=str(scratch))
+
+
+def _run(cmd: list[str], scratch: Path) -> subprocess.CompletedProcess:
+    """`cmd` run to its end in `_env(scratch)`, its output kept."""
+    return subprocess.run(cmd, env=_env(scratch), capture_output=True, text=True, timeout=300)
 
 
 @pytest.fixture(scope="module")
 def single_run(photos: Path, tmp_path_factory) -> Path:
     """The bundled model over the inputs in one process: the reference bytes."""
     out = tmp_path_factory.mktemp("single") / "out"
-    done = subprocess.run(_derender_cmd(photos, out, 1), env=_env(), capture_output=True, text=True, timeout=300)
+    done = _run(_derender_cmd(photos, out, 1), out.parent)
     assert done.returncode == 0, done.stderr[-3000:]
     return out
 
@@ -120,7 +127,7 @@ def single_run(photos: Path, tmp_path_factory) -> Path:
 @pytest.mark.slow
 def test_torchrun_two_gloo_ranks_match_one_process(photos: Path, single_run: Path, tmp_path: Path) -> None:
     out = tmp_path / "out"
-    done = subprocess.run(_derender_cmd(photos, out, 2), env=_env(), capture_output=True, text=True, timeout=300)
+    done = _run(_derender_cmd(photos, out, 2), tmp_path)
     assert done.returncode == 0, done.stderr[-3000:]
     assert summary_objects(out) == [f"vase_{k:02d}" for k in range(N_INPUTS)]  # each once, one merged summary
     assert (out / "failures.csv").read_text().splitlines() == ["source,problem"]
@@ -150,7 +157,7 @@ def _worker_pid(parent: int, rank: str) -> int | None:
 @pytest.mark.slow
 def test_a_killed_rank_is_finished_by_rerunning(photos: Path, single_run: Path, tmp_path: Path) -> None:
     out = tmp_path / "out"
-    agent = subprocess.Popen(_derender_cmd(photos, out, 2), env=_env(), stdout=subprocess.PIPE,
+    agent = subprocess.Popen(_derender_cmd(photos, out, 2), env=_env(tmp_path), stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
     share1 = [f"vase_{k:02d}" for k in (2, 3, 6, 7)]  # rank 1's batches of two: the 2nd and the 4th
     deadline, killed = time.monotonic() + 240, False
@@ -165,7 +172,7 @@ def test_a_killed_rank_is_finished_by_rerunning(photos: Path, single_run: Path, 
     assert killed and agent.returncode != 0
     unfinished = [n for n in share1 if not (out / n / "material.json").is_file()]
     assert unfinished, "rank 1 finished its share before it could be killed"
-    done = subprocess.run(_derender_cmd(photos, out, 2), env=_env(), capture_output=True, text=True, timeout=300)
+    done = _run(_derender_cmd(photos, out, 2), tmp_path)
     assert done.returncode == 0, done.stderr[-3000:]
     assert summary_objects(out) == [f"vase_{k:02d}" for k in range(N_INPUTS)]
     assert object_files(out) == object_files(single_run)
@@ -174,5 +181,5 @@ def test_a_killed_rank_is_finished_by_rerunning(photos: Path, single_run: Path, 
 @pytest.mark.slow
 def test_torchrun_refuses_a_shard_option(photos: Path, tmp_path: Path) -> None:
     cmd = _derender_cmd(photos, tmp_path / "out", 2) + ["--shard", "0/2"]
-    done = subprocess.run(cmd, env=_env(), capture_output=True, text=True, timeout=300)
+    done = _run(cmd, tmp_path)
     assert done.returncode != 0 and "--shard cannot be combined with torchrun" in done.stderr

@@ -57,7 +57,7 @@ def test_sampler_splits_the_global_batch_across_ranks():
 def _torchrun(vases32, run: Path, mode: str) -> None:
     script = run.parent / "ddp_train.py"
     script.write_text(SCRIPT)
-    env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=str(REPO))
+    env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=str(REPO), TMPDIR=str(run.parent))  # torchrun's logs
     cmd = [sys.executable, "-m", "torch.distributed.run", "--standalone", "--nproc_per_node=2", str(script),
            str(vases32), str(run), str(Path(__file__).parent), mode]
     done = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
