@@ -152,6 +152,24 @@ def test_paint_of_the_backdrops_colour_deep_inside_is_filled_and_a_handles_loop_
     assert (fill_painted_holes(body & ~near) == (body & ~near)).all()
 
 
+def test_a_hole_near_the_flank_is_paint_where_the_outline_beside_it_is_the_bodys_and_kept_beside_a_handle() -> None:
+    """A light object painted near the flank of a greyscale vase, GrabCut's mask holding a thin rim of glaze
+    beyond it: the outline there runs on as the body's, and the hole is filled. A loop handle on the same flank
+    stands out of the body beside the backdrop seen through it: that hole stays, and so does one beside the
+    neck, near the rim, where the body's outline is no parabola."""
+    y, x = np.mgrid[0:256, 0:256]
+    body = ((x - 128) / 70.0) ** 2 + ((y - 128) / 100.0) ** 2 <= 1  # rows 28-228, 140 px wide
+    inside = ((x - 128) / 66.0) ** 2 + ((y - 128) / 100.0) ** 2 <= 1  # 4 px of glaze along the flank
+    hole = inside & (x >= 185) & (np.abs(y - 128) <= 12)
+    assert (fill_painted_holes(body & ~hole) == body).all()
+    loop = ((x - 196) / 20.0) ** 2 + ((y - 128) / 26.0) ** 2
+    gap = (loop <= 0.45) & (x >= 192)  # the backdrop seen through the handle, between it and the body
+    with_handle = (body | ((loop <= 1) & (x >= 190))) & ~gap
+    assert gap.any() and (fill_painted_holes(with_handle) == with_handle).all()
+    high = inside & (x >= 150) & (np.abs(y - 45) <= 8) & ~(((x - 128) / 62.0) ** 2 + ((y - 128) / 100.0) ** 2 <= 1)
+    assert high.any() and (fill_painted_holes(body & ~high) == (body & ~high)).all()
+
+
 def test_a_large_figure_of_the_backdrops_grey_on_a_greyscale_plate_is_paint_and_a_handles_gap_is_not() -> None:
     y, x = np.mgrid[0:256, 0:256]
     body = ((x - 128) / 90.0) ** 2 + ((y - 140) / 100.0) ** 2 <= 1  # 180 px wide
