@@ -241,15 +241,13 @@ def _flush_beyond(part: np.ndarray, solid: np.ndarray, axis: float) -> bool:
     reach = max(last - first + 1, 5)
     if first - reach < top + BODY_BAND[0] * height or last + reach > top + BODY_BAND[1] * height:
         return False  # near the rim or the foot (a handle's root, a plate), the body's outline is no parabola
-    cols = np.arange(solid.shape[1])
-    if np.nonzero(part)[1].mean() > axis:
-        outer = np.where(solid, cols, -1).max(1).astype(np.float64)
-    else:
-        outer = -np.where(solid, cols, solid.shape[1]).min(1).astype(np.float64)
-    around = np.r_[first - reach : first, last + 1 : last + reach + 1]
-    body = np.polyval(np.polyfit(around, outer[around], 2), np.arange(first, last + 1))
+    span = np.arange(first - reach, last + reach + 1)  # the hole's rows and those it is judged by
+    left, right = row_extents(solid, span)
+    outer = (right if np.nonzero(part)[1].mean() > axis else -left).astype(np.float64)  # outward: larger
+    beside = np.r_[0:reach, span.size - reach : span.size]
+    body = np.polyval(np.polyfit(span[beside], outer[beside], 2), span[reach:-reach])
     used = np.nonzero(solid.any(0))[0]
-    return bool((outer[first : last + 1] - body).max() <= FLUSH * (used[-1] - used[0] + 1))
+    return bool((outer[reach:-reach] - body).max() <= FLUSH * (used[-1] - used[0] + 1))
 
 
 def open_gaps(mask: np.ndarray, image: np.ndarray, outside: np.ndarray | None = None,
