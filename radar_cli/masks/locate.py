@@ -215,25 +215,26 @@ def fill_painted_holes(mask: np.ndarray, greyscale: bool = False) -> np.ndarray:
     count, labels = cv2.connectedComponents(holes.astype(np.uint8), connectivity=4)
     filled = mask.copy()
     large = PAINT_AREA * mask.sum() if greyscale else np.inf
+    width = cols[-1] - cols[0] + 1
     for i in range(1, count):
         part = labels == i
         if part.sum() >= large:
             filled |= part
-        elif depth[part].min() >= GAP_DEPTH * (cols[-1] - cols[0] + 1) and across_axis(part, turn, axis):
+        elif depth[part].min() >= GAP_DEPTH * width and across_axis(part, turn, axis):
             filled |= part
-        elif _flush_beyond(part, solid, axis):
+        elif _flush_beyond(part, solid, axis, width):
             filled |= part
     return filled
 
 
-def _flush_beyond(part: np.ndarray, solid: np.ndarray, axis: float) -> bool:
+def _flush_beyond(part: np.ndarray, solid: np.ndarray, axis: float, width: int) -> bool:
     """Whether the object's outline beside a hole (n x n bool `part` of the n x n bool `solid`, holes filled;
-    `axis` its axis' column) runs on as the body's own, sticking out of it by at most FLUSH of the object's width:
-    the body's outline there is a parabola through the outline over as many rows above and below the hole as it
-    spans, all of them within BODY_BAND of the height. A handle stands out of the body beside the backdrop seen
-    through it; a light figure or an object painted near the flank, which GrabCut took for backdrop on a
-    greyscale photo, leaves the outline where it was (Met `DP117199` in grey: 0.0015 of the width; a handle on
-    the body, `DP250469`: 0.11-0.16)."""
+    `axis` its axis' column, `width` its width in px) runs on as the body's own, sticking out of it by at most
+    FLUSH of that width: the body's outline there is a parabola through the outline over as many rows above and
+    below the hole as it spans, all of them within BODY_BAND of the height. A handle stands out of the body
+    beside the backdrop seen through it; a light figure or an object painted near the flank, which GrabCut took
+    for backdrop on a greyscale photo, leaves the outline where it was (Met `DP117199` in grey: 0.0015 of the
+    width; a handle on the body, `DP250469`: 0.11-0.16)."""
     rows = np.nonzero(solid.any(1))[0]
     top, height = rows[0], rows[-1] - rows[0] + 1
     spans = np.nonzero(part.any(1))[0]
@@ -246,8 +247,7 @@ def _flush_beyond(part: np.ndarray, solid: np.ndarray, axis: float) -> bool:
     outer = (right if np.nonzero(part)[1].mean() > axis else -left).astype(np.float64)  # outward: larger
     beside = np.r_[0:reach, span.size - reach : span.size]
     body = np.polyval(np.polyfit(span[beside], outer[beside], 2), span[reach:-reach])
-    used = np.nonzero(solid.any(0))[0]
-    return bool((outer[reach:-reach] - body).max() <= FLUSH * (used[-1] - used[0] + 1))
+    return bool((outer[reach:-reach] - body).max() <= FLUSH * width)
 
 
 def open_gaps(mask: np.ndarray, image: np.ndarray, outside: np.ndarray | None = None,
