@@ -232,6 +232,16 @@ def outline(solid: Solid, size: int,
     return Outline(to_px(left), to_px(right), to_px(-high), to_px(-low))
 
 
+def row_mask(drawn: Outline) -> torch.Tensor:
+    """The silhouette an outline draws, from its rows' ends: the pixels whose centres lie between a row's left and
+    right end. B x S x S bool. Where every row crosses the silhouette in one run (an upright or slightly rolled
+    axis; a row of a strongly rolled, waisted vessel can cross it twice and the gap counts as drawn), this is the
+    ray cast's hard silhouette (render.raycast.hit_mask) but for the pixels an end passes within the discs'
+    sampling of, at a fifth of its cost."""
+    cols = torch.arange(drawn.left.shape[1], dtype=drawn.left.dtype, device=drawn.left.device)
+    return (cols >= drawn.left[..., None]) & (cols <= drawn.right[..., None])  # NaN rows compare False
+
+
 def mask_outline(mask: np.ndarray) -> Outline:
     """The ends of an S x S coverage mask (float in [0, 1] or bool) along every row and column, at sub-pixel
     precision: where the coverage crosses 0.5, linearly interpolated between pixel centres (a binary mask's

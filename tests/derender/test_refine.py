@@ -9,8 +9,10 @@ import torch
 
 from radar_cli.config import CameraConfig
 from radar_cli.derender.refine import driver as refine_module
-from radar_cli.derender.refine.driver import refine_object, silhouette_iou
+from radar_cli.derender.refine.driver import refine_object
+from radar_cli.masks.refine import iou
 from radar_cli.model.outputs import Decomposition
+from radar_cli.render.raycast import hit_mask
 from radar_cli.synth.generator import SynthConfig, make_sample
 
 SIZE = 512  # the default output side, where the lip's contrast was tuned
@@ -49,7 +51,7 @@ def test_refinement_recovers_pitch_and_silhouette(index, pitch_offset, radius_sc
     refined, report = refine_object(Appearance(), torch.zeros(1, 3, 64, 64), start, image, mask, CameraConfig())
     assert report.status == "refined", report
     assert abs(float(refined.pose[0, 0]) - params["pose"][0]) <= 0.5
-    assert silhouette_iou(refined.radius, refined.height, refined.pose, mask, CameraConfig()) >= 0.99
+    assert iou(hit_mask(refined.solid, SIZE, CameraConfig())[0].numpy(), mask) >= 0.99  # the ray-cast silhouette
     assert report.iou[0] >= 0.99 and report.iou[1] < report.iou[0]
     assert refined.radius.shape[1] >= 64
 

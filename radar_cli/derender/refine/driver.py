@@ -23,8 +23,7 @@ from radar_cli.derender.refine.shape_config import ShapeFitConfig
 from radar_cli.masks.refine import iou
 from radar_cli.model.outputs import Decomposition
 from radar_cli.model.specular_reader import SpecularReader
-from radar_cli.render.raycast import hit_mask
-from radar_cli.sor.outline import mask_outline, outline
+from radar_cli.sor.outline import Outline, mask_outline, outline, row_mask
 from radar_cli.sor.solid import Solid
 from radar_cli.threads import torch_threads
 
@@ -85,11 +84,9 @@ class RefineReport:
                 "glare_scale": round(self.glare_scale, 4)}
 
 
-def silhouette_iou(radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor, mask: np.ndarray,
-                   camera: CameraConfig) -> float:
-    """IoU of the ray-cast silhouette (N x N, hard) with an N x N bool mask."""
-    drawn = hit_mask(Solid(radius.float(), height.float(), pose.float()), mask.shape[0], camera)[0].cpu().numpy()
-    return iou(drawn, mask)
+def silhouette_iou(drawn: Outline, mask: np.ndarray) -> float:
+    """IoU of the silhouette an N x N outline draws (batch of one) with an N x N bool mask."""
+    return iou(row_mask(drawn)[0].cpu().numpy(), mask)
 
 
 def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarray, silhouette: np.ndarray | None,
@@ -115,15 +112,15 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
     if silhouette is None:
         return None, RefineReport("fallback", "no silhouette to fit (--crop none without --masks)", size)
     start = time.perf_counter()
-    network_iou = silhouette_iou(dec.radius, dec.height, dec.pose, silhouette, camera)
     target = mask_outline(silhouette)
-    network_px = float(outline_score(outline(dec.solid, size, camera), target,
-                                     absolute=True)[0])
+    network_drawn = outline(dec.solid, size, camera)
+    network_iou = silhouette_iou(network_drawn, silhouette)
+    network_px = float(outline_score(network_drawn, target, absolute=True)[0])
     grey = crop.astype(np.float32).mean(axis=2) / 255.0
     try:
         with torch_threads(1):  # the same bits whatever the caller's thread count (torch's sums split by thread)
             fit = fit_shape(silhouette, grey, config, camera, float(dec.pose[0, 0]))
-            refined_iou = silhouette_iou(fit.radius, fit.height, fit.pose, silhouette, camera)
+            refined_iou = silhouette_iou(outline(Solid(fit.radius, fit.height, fit.pose), size, camera), silhouette)
     except FIT_ERRORS as e:
         return None, RefineReport("fallback", f"the fit failed ({type(e).__name__}: {e})", size,
                                  outline_px=(float("nan"), network_px), iou=(float("nan"), network_iou),
