@@ -313,10 +313,12 @@ def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = Shape
     coarse_target = mask_outline(downsample(mask, grid))
     grey_t = torch.from_numpy(np.stack([np.asarray(grey, np.float32), np.asarray(mask, np.float32)]))[None]
     bands = high_pass(grey, mask, config.bands.sigma_px)
-    (radius, height, pose), cue = search_pitch(coarse_target, grey_t, grid, config, camera, prior_pitch, bands)
     target = mask_outline(np.asarray(mask, np.float64))
-    radius = correct_widths(target, size, radius, height, pose, config.width_rounds, camera,
-                            config.end_px * size / 256)
+    with torch.inference_mode():  # no gradients until the polish: less bookkeeping per operation
+        (radius, height, pose), cue = search_pitch(coarse_target, grey_t, grid, config, camera, prior_pitch, bands)
+        radius = correct_widths(target, size, radius, height, pose, config.width_rounds, camera,
+                                config.end_px * size / 256)
+    radius, height, pose = radius.clone(), height.clone(), pose.clone()  # tensors the polish can differentiate
     for level, steps in zip((grid, size), config.polish_steps):
         level_target = coarse_target if level == grid else target
         radius, height, pose = polish(level_target, level, radius, height, pose, steps, config, camera)

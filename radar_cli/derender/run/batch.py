@@ -364,10 +364,11 @@ class _Batches:
             refined, report = predictor.refine_object(dec, prep.image, prep.photo_image, prep.photo_silhouette)
             if report.status == "fallback":
                 self.say(f"{item.image_path}: refinement fell back to the network's prediction: {report.reason}")
-            state = full_resolution_state(refined, prep, predictor.setup, predictor.albedo)
-            export_object(self.options.out / item.name, item, prep, state, predictor.setup, predictor.version,
-                          self.envs, self.options.export, predictor.albedo, predictor.pitch, report.record(),
-                          found.size, description=found.description)
+            with torch.inference_mode():  # no gradients from here on, and less bookkeeping per operation
+                state = full_resolution_state(refined, prep, predictor.setup, predictor.albedo)
+                export_object(self.options.out / item.name, item, prep, state, predictor.setup, predictor.version,
+                              self.envs, self.options.export, predictor.albedo, predictor.pitch, report.record(),
+                              found.size, description=found.description)
         except ITEM_ERRORS as e:
             return Failure(str(item.image_path), f"export failed ({type(e).__name__}: {e})")
         return None
