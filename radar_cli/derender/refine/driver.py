@@ -120,7 +120,7 @@ def refine_object(model, image: torch.Tensor, dec: Decomposition, crop: np.ndarr
     try:
         with torch_threads(1):  # the same bits whatever the caller's thread count (torch's sums split by thread)
             fit = fit_shape(silhouette, grey, config, camera, float(dec.pose[0, 0]))
-            refined_iou = silhouette_iou(outline(Solid(fit.radius, fit.height, fit.pose), size, camera), silhouette)
+            refined_iou = silhouette_iou(fit.drawn, silhouette)
     except FIT_ERRORS as e:
         return None, RefineReport("fallback", f"the fit failed ({type(e).__name__}: {e})", size,
                                  outline_px=(float("nan"), network_px), iou=(float("nan"), network_iou),

@@ -41,6 +41,7 @@ class ShapeFit:
         outline_error: mean distance in px (at the fitted resolution) between the fitted and the target outline.
         pitch_cue: what picked the pitch: `band` (painted bands), `lip` (the rim's front arc), `dark_lip` (the
             same arc, its contrast taken relative to its grey level) or `outline`.
+        drawn: the fitted solid's outline at the fitted resolution (what outline_error was read from).
     """
 
     radius: torch.Tensor
@@ -48,6 +49,7 @@ class ShapeFit:
     pose: torch.Tensor
     outline_error: float
     pitch_cue: str
+    drawn: Outline
 
 
 def huber(d: torch.Tensor, delta: float = 1.0) -> torch.Tensor:
@@ -324,8 +326,9 @@ def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = Shape
         radius, height, pose = polish(level_target, level, radius, height, pose, steps, config, camera)
     if config.smooth_hidden:
         radius = smooth_hidden(radius, height, pose, target, size, camera, outline_score)
-    error = float(outline_score(outline(Solid(radius, height, pose), size, camera), target, absolute=True)[0])
-    return ShapeFit(radius.float(), height.float(), pose.float(), error, cue)
+    drawn = outline(Solid(radius, height, pose), size, camera)
+    error = float(outline_score(drawn, target, absolute=True)[0])
+    return ShapeFit(radius.float(), height.float(), pose.float(), error, cue, drawn)
 
 
 def correct_widths(target: Outline, size: int, radius: torch.Tensor, height: torch.Tensor, pose: torch.Tensor,
