@@ -6,8 +6,9 @@ objects of a results folder (docs/performance.md):
 - the turntable GIF's palette: Pillow's median cut of every pixel of turntable.png's frames (and its mapping)
   against export.palette.quantize; each one's mean error against the frames (levels);
 - mesh.obj: trimesh's OBJ exporter against export.mesh.obj_text (the bytes compared);
-- the refinement's hard silhouette at the output side: a full ray cast against render.raycast.hit_mask, for the
-  profile, height and pose of material.json (the masks compared);
+- the refinement's silhouette at the output side: the hard silhouette ray-cast (render.raycast.hit_mask) against
+  the pixels between the rows' ends of the closed-form outline (sor.outline.row_mask), for the profile, height and
+  pose of material.json (the masks' IoU);
 - the input view, its turntable (8 frames) and its 4 relit views: each view's texture composed anew (and the
   input view's shading made twice, for it and for the turntable) against ViewRenderer.draw, whose unspun views
   draw the texture their shading holds, with the turntable started from the input view's shading and
@@ -35,10 +36,12 @@ from radar_cli.derender.export.mesh import OBJ_MTL, obj_text
 from radar_cli.derender.export.palette import quantize
 from radar_cli.derender.export.renders import ViewRenderer
 from radar_cli.derender.run.state import read_state
+from radar_cli.masks.refine import iou
 from radar_cli.render.lighting import compose
-from radar_cli.render.raycast import cast_rays, hit_mask
+from radar_cli.render.raycast import hit_mask
 from radar_cli.render.scene import rotate_full_map
 from radar_cli.render.texture import render_texture
+from radar_cli.sor.outline import outline, row_mask
 from radar_cli.sor.solid import Solid
 
 
@@ -79,16 +82,16 @@ def obj_file(folder: Path, repeats: int) -> list[float]:
 
 
 def iou_cast(folder: Path, repeats: int) -> list[float]:
-    """[full cast s, hit_mask s, 1 if the masks agree] at material.json's resolution (its 128-row profile: the
-    refinement's are 32 and 64 rows, so cheaper)."""
+    """[hit_mask s, outline and row_mask s, the two masks' IoU] at material.json's resolution (its 128-row
+    profile)."""
     record = json.loads((folder / "material.json").read_text())
     solid = Solid(torch.tensor([record["radius"]], dtype=torch.float32), torch.tensor([record["height"]]),
                   torch.tensor([[record["pitch"], record["roll"], record["tx"], record["ty"]]]))
     size, camera = int(record["resolution"]), CameraConfig()
     with torch.no_grad():
-        old_s, old = best_cpu(lambda: cast_rays(solid, size, camera, 1.0, soft_outside=False).mask, repeats)
-        new_s, new = best_cpu(lambda: hit_mask(solid, size, camera), repeats)
-    return [old_s, new_s, float(torch.equal(old, new))]
+        old_s, old = best_cpu(lambda: hit_mask(solid, size, camera)[0], repeats)
+        new_s, new = best_cpu(lambda: row_mask(outline(solid, size, camera))[0], repeats)
+    return [old_s, new_s, iou(old.numpy(), new.numpy())]
 
 
 def views(folder: Path, repeats: int) -> list[float]:
