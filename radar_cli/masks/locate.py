@@ -314,11 +314,19 @@ def open_gaps(mask: np.ndarray, image: np.ndarray, outside: np.ndarray | None = 
     return main_component(mask & ~gaps) if gaps.any() else mask
 
 
+def stands_upright(found: Located) -> bool:
+    """Whether a located vessel stands clear of the frame with its symmetric core's mirror axis within
+    STRAIGHTEN[0] of vertical in its crop. Read on the core, not on all that was located: a part on one side only
+    (a head perched on one end of the rim) tilts the whole's mirror axis."""
+    return not found.cut_edges and abs(fine_tilt(found.silhouette, 0.0)[0]) < STRAIGHTEN[0]
+
+
 def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: float = crops.DEFAULT_MARGIN) -> Located:
     """Locate the vessel of a photo and cut its square crop around the symmetric core. A vessel whose axis
     leans by STRAIGHTEN degrees (a camera not quite level, a scan turned on the glass), standing clear of the
     frame and clearly more symmetric upright (STRAIGHT_AGREEMENT, STRAIGHT_GAIN), is located again on the photo
-    turned upright: its crop is straightened (`box.turn`).
+    turned upright: its crop is straightened (`box.turn`) where the vessel located there stands upright
+    (`stands_upright`).
 
     Args:
         photo: H x W x 3 uint8 RGB, or H x W x 4 RGBA (a transparent cut-out's alpha is its silhouette).
@@ -339,8 +347,8 @@ def locate_object(photo: np.ndarray, size: int, name: str = "image", margin: flo
     solid = upright_agreement >= max(STRAIGHT_AGREEMENT, level_agreement + STRAIGHT_GAIN)
     if leans and solid and not found.cut_edges and opaque is None:
         turned, affine = crops.turned_photo(rgb, tilt)
-        upright, (still, _, _) = _locate(turned, None, settings, name)
-        if not upright.cut_edges and abs(still) < STRAIGHTEN[0]:  # the same vessel, now upright
+        upright, _ = _locate(turned, None, settings, name)
+        if stands_upright(upright):  # the same vessel, now upright
             scale = turned.shape[0] * turned.shape[1] / (rgb.shape[0] * rgb.shape[1])
             found = replace(upright, box=crops.box_in_photo(upright.box, affine, tilt),
                             frame_coverage=min(1.0, upright.frame_coverage * scale))

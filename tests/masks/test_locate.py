@@ -3,6 +3,8 @@ splitting off its appendages, on rendered vases pasted over backdrops (the truth
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import cv2
 import numpy as np
 import pytest
@@ -10,8 +12,15 @@ import pytest
 from radar_cli.errors import InputError
 from radar_cli.masks import crop as crops
 from radar_cli.masks import detect
-from radar_cli.masks.appendages import symmetric_core
-from radar_cli.masks.locate import fill_painted_holes, locate_object, open_gaps, remove_stand
+from radar_cli.masks.appendages import fine_tilt, symmetric_core
+from radar_cli.masks.locate import (
+    STRAIGHTEN,
+    fill_painted_holes,
+    locate_object,
+    open_gaps,
+    remove_stand,
+    stands_upright,
+)
 from radar_cli.masks.refine import iou
 from radar_cli.masks.synthetic import composite, render_vases
 from radar_cli.masks.variants import KINDS, Variant, make_variant, with_handles
@@ -257,6 +266,21 @@ def _axis_lean_deg(silhouette: np.ndarray) -> float:
     rows = np.nonzero(silhouette.any(1))[0]
     mids = [np.nonzero(silhouette[y])[0].mean() for y in rows]
     return float(np.degrees(np.arctan(np.polyfit(rows, mids, 1)[0])))
+
+
+def test_a_vessel_stands_upright_by_its_core_whatever_stands_on_one_side_of_its_rim(sources: list) -> None:
+    """A head perched on one end of the rim tilts the mirror axis of all that was located, not the core's: a
+    straightened photo whose crop also holds such a part is still read as upright."""
+    found = locate_object(sources[0][0], SIZE)
+    assert stands_upright(found)
+    rows, cols = np.nonzero(found.silhouette)
+    head = np.zeros(found.silhouette.shape, np.uint8)
+    r = max(4, int(0.25 * (cols.max() - cols.min())))  # a lid's head, half the rim wide
+    cv2.circle(head, (int(cols[rows == rows.min()].max()), max(int(rows.min()) - r + 2, r)), r, 1, -1)
+    whole = found.silhouette | found.appendages | (head > 0)
+    assert abs(fine_tilt(whole, 0.0)[0]) >= STRAIGHTEN[0]  # read on the whole, it leans
+    assert stands_upright(replace(found, appendages=whole & ~found.silhouette))
+    assert not stands_upright(replace(found, cut_edges=("left",)))
 
 
 def test_a_photo_turned_a_few_degrees_is_straightened_and_its_crop_maps_back_to_the_photo(sources: list) -> None:
