@@ -160,7 +160,7 @@ def _row_ends(q: torch.Tensor, lines: tuple[float, float, int]) -> tuple[torch.T
     a, b = -q01 / q11, -q12 / q11
     xa, xb = roots(q00 + 2 * q01 * a + q11 * a * a, q01 * b + q11 * a * b + q02 + q12 * a,
                    q11 * b * b + 2 * q12 * b + q22)  # B x K
-    sides = ((xa, a * xa + b), (xb, a * xb + b))
+    sides = ((xa, _on_line(xa, a, b)), (xb, _on_line(xb, a, b)))
     y0, dy, n = lines
     with torch.no_grad():
         discs = disc_winners(conic, *_tangent_heights(_adjugate(q)), sides, lines)  # (left, right), B x N
@@ -182,6 +182,13 @@ def _row_ends(q: torch.Tensor, lines: tuple[float, float, int]) -> tuple[torch.T
         side = torch.where(segment < q.shape[1] - 1, side, torch.full_like(side, math.nan))
         ends.append(torch.fmin(crossing, side) if i == 0 else torch.fmax(crossing, side))
     return ends[0], ends[1]
+
+
+def _on_line(x: torch.Tensor, a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
+    """a x + b, NaN where x is, with no NaN in its gradient there (an ellipse seen edge-on has no leftmost point:
+    a plain a x + b would send 0 x NaN back to a and poison the whole solid's gradient)."""
+    found = ~x.isnan()
+    return torch.where(found, a * torch.where(found, x, torch.zeros_like(x)) + b, x)
 
 
 def _segment(x0: torch.Tensor, x1: torch.Tensor, y0: torch.Tensor, y1: torch.Tensor, at: torch.Tensor) -> torch.Tensor:

@@ -57,6 +57,36 @@ def test_outline_is_differentiable_in_shape_and_pose():
     assert radius.grad.abs().sum() > 0 and pose.grad[0, 0] != 0
 
 
+def test_a_disc_without_a_leftmost_point_leaves_the_gradient_finite(monkeypatch):
+    """A disc seen almost edge-on can have no real leftmost point (NaN): the rows it does not win must not pass
+    0 x NaN back into the whole solid's gradient (a shape fit of a small crop diverged to NaN so)."""
+    import radar_cli.sor.outline as module
+
+    radius, height, pose = (t.double() for t in _vase(3.0, -0.2, 0.01, 0.02))
+    plain = outline(Solid(radius, height, pose), 96, CameraConfig())
+    first = []
+
+    def roots_missing_one(qa, qb, qc):
+        low, high = roots_of(qa, qb, qc)
+        if not first and low.dim() == 2:  # the sides' leftmost and rightmost points, B x K: one disc loses them
+            first.append(True)
+            gone = torch.zeros_like(low, dtype=torch.bool)
+            gone[:, low.shape[1] // 3] = True
+            low, high = (torch.where(gone, torch.full_like(low, float("nan")), t) for t in (low, high))
+        return low, high
+
+    roots_of = module.roots
+    monkeypatch.setattr(module, "roots", roots_missing_one)
+    radius.requires_grad_(True)
+    pose.requires_grad_(True)
+    drawn = outline(Solid(radius, height, pose), 96, CameraConfig())
+    assert first
+    torch.nan_to_num(drawn.right - drawn.left).sum().backward()
+    assert torch.isfinite(radius.grad).all() and torch.isfinite(pose.grad).all()
+    assert torch.equal(drawn.left.isnan(), plain.left.isnan())  # its neighbours' ellipses still hold the rows
+    assert float(torch.nan_to_num(drawn.left.detach() - plain.left).abs().mean()) < 0.05  # a few rows move a little
+
+
 def test_mask_outline_sub_pixel():
     m = np.zeros((5, 8))
     m[1:4, 2:6] = 1.0

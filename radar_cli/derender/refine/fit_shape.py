@@ -309,6 +309,9 @@ def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = Shape
 
     Returns:
         ShapeFit at resolution N (polished at N, searched at min(N, config.grid_size)).
+
+    Raises:
+        FloatingPointError: the fit diverged (derender.refine.driver.FIT_ERRORS: the caller keeps the network's).
     """
     size = mask.shape[0]
     grid = min(size, config.grid_size)
@@ -326,6 +329,8 @@ def fit_shape(mask: np.ndarray, grey: np.ndarray, config: ShapeFitConfig = Shape
         radius, height, pose = polish(level_target, level, radius, height, pose, steps, config, camera)
     if config.smooth_hidden:
         radius = smooth_hidden(radius, height, pose, target, size, camera, outline_score)
+    if not all(bool(torch.isfinite(t).all()) for t in (radius, height, pose)):
+        raise FloatingPointError("the shape fit diverged (its profile or pose is not finite)")
     drawn = outline(Solid(radius, height, pose), size, camera)
     error = float(outline_score(drawn, target, absolute=True)[0])
     return ShapeFit(radius.float(), height.float(), pose.float(), error, cue, drawn)
