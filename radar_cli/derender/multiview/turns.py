@@ -26,6 +26,8 @@ SPREAD_TIE_BREAK = 1e-6  # per degree of the smallest gap between views: decides
 HANDLE_SIDE = 0.75  # an appendage centred beyond this share of the half-width from the axis stands out at a side
 HANDLE_MIDDLE = 0.35  # ... one centred within this share stands in front of (or behind) the middle
 HANDLE_MIN_SHARE = 0.003  # appendage pieces under this share of the core's area are left out (specks, a label)
+MAX_ASSIGNMENTS = 1024  # assignments of views to the prior's steps polished one by one; where there are more, ...
+BEAM = 64  # ... the views are assigned one at a time, keeping this many of the best partial assignments
 
 
 @dataclass(frozen=True)
@@ -195,13 +197,58 @@ def _allowed(slots: tuple[float, ...], phases: list[float | None]) -> bool:
                for (sj, pj), (sk, pk) in itertools.combinations(known, 2))
 
 
+def _assignments(count: int, curves: dict, config: TurnConfig,
+                 phases: list[float | None] | None) -> list[tuple[float, ...]]:
+    """The assignments of the views to the prior's steps (degrees per view, the first at 0) worth polishing: views
+    on distinct steps, or steps reused where there are more views than steps; only those the handle phases allow
+    where any is. All of them up to MAX_ASSIGNMENTS; beyond, the BEAM best of a beam search (`_beam`)."""
+    steps = max(1, int(round(360 / config.step_deg)))
+    distinct = count - 1 <= steps - 1
+    if (math.perm(steps - 1, count - 1) if distinct else steps ** (count - 1)) <= MAX_ASSIGNMENTS:
+        choices = (itertools.permutations(range(1, steps), count - 1) if distinct
+                   else itertools.product(range(steps), repeat=count - 1))
+        candidates = [(0.0, *(c * config.step_deg for c in choice)) for choice in choices]
+    else:
+        candidates = _beam(count, steps, curves, config, phases)
+    if phases is not None and any(_allowed(s, phases) for s in candidates):
+        candidates = [s for s in candidates if _allowed(s, phases)]
+    return candidates
+
+
+def _beam(count: int, steps: int, curves: dict, config: TurnConfig,
+          phases: list[float | None] | None) -> list[tuple[float, ...]]:
+    """The BEAM best assignments of `count` views to `steps` steps (reused), the views placed one at a time: each
+    partial assignment scored by its pairs' best agreement within reach of their steps' difference, those the
+    handle phases allow ranked first (ties by the steps, so the same views give the same turns)."""
+    reach = np.arange(-int(config.reach_deg), int(config.reach_deg) + 1)
+    best_near: dict[tuple[int, int, int], float] = {}
+
+    def agreement(j: int, k: int, delta: int) -> float:
+        """Views j and k's best weighted correlation within reach of a turn `delta` (degrees) between them."""
+        if (j, k, delta) not in best_near:
+            ncc, weight = curves[(j, k)]
+            best_near[(j, k, delta)] = float((ncc * weight)[(delta + reach) % 360].max())
+        return best_near[(j, k, delta)]
+
+    def degrees(chosen: tuple[int, ...]) -> tuple[float, ...]:
+        return tuple(c * config.step_deg for c in chosen)
+
+    beam: list[tuple[float, tuple[int, ...]]] = [(0.0, (0,))]
+    for k in range(1, count):
+        grown = [(score + sum(agreement(j, k, round((s - chosen[j]) * config.step_deg) % 360) for j in range(k)),
+                  (*chosen, s)) for score, chosen in beam for s in range(steps)]
+        grown.sort(key=lambda t: (phases is not None and not _allowed(degrees(t[1]), phases), -t[0], t[1]))
+        beam = grown[:BEAM]
+    return [degrees(chosen) for _, chosen in beam]
+
+
 def register_turns(views: list[ViewTexture], config: TurnConfig = TurnConfig(),
                    phases: list[float | None] | None = None) -> Turns:
     """The turns of V views (each ViewTexture in its own frame) relative to the first: every assignment of the
     views to distinct steps of the prior (or steps reused, with more views than steps) that the views' handle
-    phases allow (`phases`, handle_phase per view; all assignments where none does) is polished by coordinate
-    ascent and the best total agreement kept. A turn that ends at the edge of its reach found no peak there and
-    keeps its step (not registered)."""
+    phases allow (`phases`, handle_phase per view; all assignments where none does; `_assignments`) is polished by
+    coordinate ascent and the best total agreement kept. A turn that ends at the edge of its reach found no peak
+    there and keeps its step (not registered)."""
     count = len(views)
     details = [detail_map(v, config) for v in views]
     curves = {}
@@ -209,13 +256,7 @@ def register_turns(views: list[ViewTexture], config: TurnConfig = TurnConfig(),
         ncc, weight = correlation(details[i], details[j], config)
         curves[(i, j)] = (ncc, weight)
         curves[(j, i)] = (np.roll(ncc[::-1], 1), np.roll(weight[::-1], 1))  # d -> -d
-    steps = max(1, int(round(360 / config.step_deg)))
-    others = range(1, steps)
-    choices = (itertools.permutations(others, count - 1) if count - 1 <= len(others)
-               else itertools.product(range(steps), repeat=count - 1))
-    candidates = [(0.0, *(c * config.step_deg for c in choice)) for choice in choices]
-    if phases is not None and any(_allowed(s, phases) for s in candidates):
-        candidates = [s for s in candidates if _allowed(s, phases)]
+    candidates = _assignments(count, curves, config, phases)
     best: tuple[np.ndarray, float, tuple[float, ...]] = (np.zeros(count), -np.inf, candidates[0])
     for slots in candidates:
         theta, total = _ascend(slots, curves, config)
