@@ -296,23 +296,34 @@ def symmetric_core(mask: np.ndarray) -> Core:
     return Core(core, rest, tilt, axis, sor_score(core))
 
 
-def above_rim(whole: np.ndarray, core: np.ndarray, rim_rows: float = 0.02) -> tuple[float, float]:
+def above_rim(whole: np.ndarray, core: np.ndarray, rim_rows: float = 0.02) -> tuple[float, float, float]:
     """What of the located object stands above the core's top over the mouth (within the columns of the core's
     top rows, its rim), left out of the core: (its area over the core's, its rise above the rim over the rim's
-    width). A lid's head, a stopper, a figure or flowers rise there and are bulky or tall; a volute or a handle's
-    plate seen end-on rises there too but is thin and low (on the kraters measured at most 0.03 of the core,
-    rising 0.19 of the rim's width). (0, 0) where nothing stands above the rim.
+    width, the share of it whose mirror image about the core's axis stands there too). A lid's head, a stopper, a
+    figure or flowers rise there and are bulky or tall; a volute or a handle's plate seen end-on rises there too
+    but is thin and low (on the kraters measured at most 0.03 of the core, rising 0.19 of the rim's width), and
+    stands as a pair at the rim's two ends or in the middle (mirrored: 0.57-0.98 on the vessels measured), where a
+    head set on one side of the rim is not (0-0.26 on the generated lids). (0, 0, 1) where nothing stands above
+    the rim.
 
     Args:
         whole: n x n bool located object (core and appendages). core: n x n bool, its symmetric core.
     """
     rows = np.nonzero(core.any(1))[0]
     if len(rows) < 2:
-        return 0.0, 0.0
+        return 0.0, 0.0, 1.0
     top = int(rows[0])
     cols = np.nonzero(core[top : top + max(2, int(rim_rows * (rows[-1] - top + 1)))].any(0))[0]
     over = whole[:top, cols[0] : cols[-1] + 1]
     standing = np.nonzero(over.any(1))[0]
     if not standing.size:
-        return 0.0, 0.0
-    return float(over.sum() / max(int(core.sum()), 1)), float((top - standing[0]) / (cols[-1] - cols[0] + 1))
+        return 0.0, 0.0, 1.0
+    ends = [np.nonzero(row)[0] for row in core[rows]]
+    axis = float(np.median([(e[0] + e[-1]) / 2.0 for e in ends if e.size])) - cols[0]  # in `over`'s columns
+    ys, xs = np.nonzero(over)
+    mirrored = np.rint(2.0 * axis - xs).astype(int)
+    inside = (mirrored >= 0) & (mirrored < over.shape[1])
+    both = np.zeros(xs.size, bool)
+    both[inside] = over[ys[inside], mirrored[inside]]
+    return (float(over.sum() / max(int(core.sum()), 1)), float((top - standing[0]) / (cols[-1] - cols[0] + 1)),
+            float(both.mean()))

@@ -75,7 +75,8 @@ class Located:
         base_off_axis: share of the lowest rows of the located object off its symmetric core (a neighbour
             probably kept with it where large; `neighbours.base_off_axis`).
         above_rim: what of the object stands above its rim over the mouth, left out of the core (a lid's head,
-            a stopper, flowers; `appendages.above_rim`): its area over the core's, its rise over the rim's width.
+            a stopper, flowers; `appendages.above_rim`): its area over the core's, its rise over the rim's width,
+            the share of it mirrored about the axis.
         painted_fill: on a greyscale photo, the share of the object filled in as paint of the backdrop's grey
             (`fill_painted_holes`): where large, the outline is a guess (0 on colour photos).
         greyscale: whether the photo is greyscale (`detect.is_greyscale` of the refinement window): the outline
@@ -92,7 +93,7 @@ class Located:
     stand_removed: bool = False
     neighbour_removed: bool = False
     base_off_axis: float = 0.0
-    above_rim: tuple[float, float] = (0.0, 0.0)
+    above_rim: tuple[float, float, float] = (0.0, 0.0, 1.0)
     painted_fill: float = 0.0
     greyscale: bool = False
 

@@ -47,6 +47,7 @@ def test_a_good_result_is_ok() -> None:
     ({"base_width": 0.16, "base_spread": 1.0}, "review", "narrow stem"),
     ({"above_rim": 0.14, "above_rim_rise": 0.1}, "review", "stands on the rim"),
     ({"above_rim": 0.05, "above_rim_rise": 0.4}, "review", "stands on the rim"),
+    ({"above_rim": 0.05, "above_rim_rise": 0.25, "above_rim_mirrored": 0.18}, "review", "stands on the rim"),
     ({"cut_edges": ["top"]}, "review", "cuts off the object's top"),
     ({"cut_edges": ["left", "right"]}, "review", "cuts off both sides"),
     ({"face": 0.4}, "review", "a face looks out of the object"),
@@ -62,6 +63,13 @@ def test_a_foot_or_flank_on_the_frame_alone_is_ok() -> None:
     """A vessel standing on the photo's bottom edge or touching a side shows its whole outline: ok."""
     assert judge({**GOOD, "cut_edges": ["bottom", "right"], "above_rim": 0.03,
                   "above_rim_rise": 0.19}) == ("ok", [])
+
+
+def test_handles_rising_above_the_rim_in_a_pair_or_a_thin_one_alone_are_ok() -> None:
+    """A krater's handles or volutes above its rim stand in pairs (mirrored about the axis); one thin volute's
+    tip alone is too small to say anything."""
+    assert judge({**GOOD, "above_rim": 0.049, "above_rim_rise": 0.14, "above_rim_mirrored": 0.81}) == ("ok", [])
+    assert judge({**GOOD, "above_rim": 0.02, "above_rim_rise": 0.1, "above_rim_mirrored": 0.0}) == ("ok", [])
 
 
 def test_the_same_symmetry_on_a_colour_photo_is_ok() -> None:

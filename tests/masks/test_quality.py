@@ -171,15 +171,23 @@ def test_a_stem_broken_off_ends_narrow_and_a_foot_spreads() -> None:
 
 def test_what_stands_on_the_rim_is_measured_against_the_vessel() -> None:
     """A head on a lid, left out of the core, is a large share of the vessel above its rim; a thin handle's top
-    rising above the rim is a small one; a plain vessel has none."""
+    rising above the rim is a small one; a plain vessel has none. A pair of volutes at the rim's ends, or a head
+    in its middle, is mirrored about the axis; a head set on one end of the rim is not."""
     core = np.zeros((200, 200), bool)
-    core[80:190, 60:140] = True  # the vessel, its rim at row 80
+    core[80:190, 60:140] = True  # the vessel, its rim at row 80, its axis at column 99.5
     head = core.astype(np.uint8)
     cv2.circle(head, (105, 55), 28, 1, -1)
-    share, rise = above_rim(head > 0, core)
+    share, rise, mirrored = above_rim(head > 0, core)
     assert share > 0.12 and abs(rise - 53 / 80) < 0.02  # the circle's top at row 27: 53 rows over an 80 px rim
+    assert mirrored > 0.7  # 5 px off the axis: most of it mirrored
     handle = core.copy()
     handle[65:80, 62:70] = True  # a volute's end, thin, at the rim's end
-    share, rise = above_rim(handle, core)
-    assert 0 < share < 0.03 and abs(rise - 15 / 80) < 0.01
-    assert above_rim(core, core) == (0.0, 0.0)
+    share, rise, mirrored = above_rim(handle, core)
+    assert 0 < share < 0.03 and abs(rise - 15 / 80) < 0.01 and mirrored == 0.0
+    handle[65:80, 130:138] = True  # and its pair at the other end
+    assert above_rim(handle, core)[2] == 1.0
+    aside = core.astype(np.uint8)
+    cv2.circle(aside, (125, 60), 22, 1, -1)  # a head perched on the right end of the rim
+    share, _, mirrored = above_rim(aside > 0, core)
+    assert share > 0.03 and mirrored < 0.2
+    assert above_rim(core, core) == (0.0, 0.0, 1.0)

@@ -122,6 +122,10 @@ class QualityLimits:
     review_above_rim_rise: tuple[float, float] = (0.03, 0.3)
     """... or more than the first (area) rising above the rim by more than the second (of the rim's width,
     `above_rim_rise`): review. A volute or a handle's plate seen end-on is thin and low."""
+    review_above_rim_aside: tuple[float, float] = (0.03, 0.4)
+    """... or more than the first (area) with less than the second of it mirrored about the axis
+    (`above_rim_mirrored`): review. Volutes and handles' plates stand in pairs at the rim's ends or end-on in
+    its middle; a head set on one side of the rim stands alone."""
     review_cut_top: bool = True
     """An object the photo's top edge cuts: review (its rim, and whatever stands on it, is not in the photo)."""
     review_cut_sides: bool = True
@@ -172,7 +176,8 @@ def scores(prepared: Prepared, drawing: InputDrawing) -> dict:
             "painted_fill": _round(prepared.painted_fill),
             "greyscale": prepared.greyscale,
             "above_rim": None if prepared.above_rim is None else _round(prepared.above_rim[0]),
-            "above_rim_rise": None if prepared.above_rim is None else _round(prepared.above_rim[1])}
+            "above_rim_rise": None if prepared.above_rim is None else _round(prepared.above_rim[1]),
+            "above_rim_mirrored": None if prepared.above_rim is None else _round(prepared.above_rim[2])}
 
 
 def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None, rendered: np.ndarray,
@@ -284,7 +289,9 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
          "the object ends below in a narrow stem ({:.2f} of its width) that does not spread into a foot: broken "
          "off, or a toe made for a stand?"),
         ("above_rim", lambda v: v > limits.review_above_rim or (v > limits.review_above_rim_rise[0] and (
-            record.get("above_rim_rise") or 0) > limits.review_above_rim_rise[1]),
+            record.get("above_rim_rise") or 0) > limits.review_above_rim_rise[1]) or (
+            v > limits.review_above_rim_aside[0] and record.get("above_rim_mirrored") is not None
+            and record["above_rim_mirrored"] < limits.review_above_rim_aside[1]),
          "something stands on the rim and is left out of the solid ({:.2f} of the vessel's size): a lid, a "
          "stopper, a figure or flowers?"),
         ("roundness", lambda v: v >= limits.review_roundness and (record.get("rim_contrast") or 0) >= limits.review_rim,

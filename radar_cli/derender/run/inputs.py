@@ -105,8 +105,8 @@ class Prepared:
         base_off_axis: share of the located object's lowest rows off its symmetric core (a neighbour kept
             with it where large); None if not located.
         above_rim: what of the located object stands above its rim over the mouth, left out of the core (a
-            lid's head, a stopper, flowers): its area over the core's, its rise over the rim's width; None if not
-            located.
+            lid's head, a stopper, flowers): its area over the core's, its rise over the rim's width, the share of
+            it mirrored about the axis; None if not located.
         painted_fill: on a greyscale photo, the share of the located object filled in as paint of the
             backdrop's grey (masks.locate.Located); None if not located.
         greyscale: whether the located photo is greyscale (its outline read from brightness alone).
@@ -125,7 +125,7 @@ class Prepared:
     photo_scene: np.ndarray | None = None
     neighbour_cut: bool = False
     base_off_axis: float | None = None
-    above_rim: tuple[float, float] | None = None
+    above_rim: tuple[float, float, float] | None = None
     painted_fill: float | None = None
     greyscale: bool = False
 
@@ -361,7 +361,8 @@ def located_input(photo: np.ndarray, size: int, name: str, backdrop: Backdrop = 
                        appendages=resize_mask(found.appendages, side), cut_edges=found.cut_edges,
                        frame_coverage=round(found.frame_coverage, 4), neighbour_cut=found.neighbour_removed,
                        base_off_axis=round(found.base_off_axis, 4),
-                       above_rim=(round(found.above_rim[0], 4), round(found.above_rim[1], 4)),
+                       above_rim=(round(found.above_rim[0], 4), round(found.above_rim[1], 4),
+                                  round(found.above_rim[2], 4)),
                        painted_fill=round(found.painted_fill, 4), greyscale=found.greyscale)
     return _on_backdrop(located, backdrop)
 
