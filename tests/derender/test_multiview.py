@@ -177,6 +177,28 @@ def test_a_multiview_folder_with_an_unreadable_photo_goes_on(tmp_path: Path, pre
     assert (out / "failures.csv").read_bytes() == report
 
 
+def test_photos_of_two_vessels_in_one_folder_are_review(tmp_path: Path, predictor: Predictor) -> None:
+    """Two photos of one vase and one of another in one folder: the solid drawn through all three lies off the
+    odd one's silhouette (`views_outline`), and the object is not `ok`; the photos of one vase alone keep to it."""
+    from PIL import Image
+
+    egg = np.full((80, 80, 3), 225, np.uint8)  # the ellipse's height, narrow at the top and wide below
+    yy, xx = np.mgrid[0:80, 0:80]
+    t = (yy - 40) / 28.0
+    egg[(np.abs(t) < 1) & (np.abs(xx - 40) < 16.0 * (1 + 0.35 * t) * np.sqrt(np.clip(1 - t * t, 0, 1)))] = 90
+    for name, odd in (("same", False), ("mixed", True)):
+        for k in range(3):
+            path = write_photo(tmp_path / "in" / name / f"view{k}.png", 3, (80, 80))
+            if odd and k == 2:
+                Image.fromarray(egg).save(path)
+    out = tmp_path / "out"
+    derender([tmp_path / "in"], predictor, DerenderOptions(out=out, export=ExportConfig(views=0, view_size=32)))
+    same, mixed = (json.loads((out / n / "material.json").read_text())["quality"] for n in ("same", "mixed"))
+    assert same["views_outline"] < 0.015 and not any("fitted to them all" in r for r in same["reasons"])
+    assert mixed["views_outline"] > 0.015 and mixed["status"] != "ok"
+    assert any("fitted to them all" in r for r in mixed["reasons"]), mixed["reasons"]
+
+
 @pytest.mark.slow  # about 35 s on a busy 2-core machine
 def test_eval_views_scores_every_side_view(tmp_path: Path, predictor: Predictor) -> None:
     from radar_cli.evaluate.held_out import evaluate_views, summary_line

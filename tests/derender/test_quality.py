@@ -48,6 +48,7 @@ def test_a_good_result_is_ok() -> None:
     ({"above_rim": 0.14, "above_rim_rise": 0.1}, "review", "stands on the rim"),
     ({"above_rim": 0.05, "above_rim_rise": 0.4}, "review", "stands on the rim"),
     ({"above_rim": 0.05, "above_rim_rise": 0.25, "above_rim_mirrored": 0.18}, "review", "stands on the rim"),
+    ({"views_outline": 0.023}, "review", "fitted to them all"),
     ({"cut_edges": ["top"]}, "review", "cuts off the object's top"),
     ({"cut_edges": ["left", "right"]}, "review", "cuts off both sides"),
     ({"face": 0.4}, "review", "a face looks out of the object"),

@@ -47,7 +47,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
                   version: str, envs: dict[str, np.ndarray], config: ExportConfig = ExportConfig(),
                   albedo_source: AlbedoSource = "network", pitch_source: PitchSource = "network",
                   refine: dict | None = None, size: ObjectSize | None = None, extra: dict | None = None,
-                  description: str = "") -> dict:
+                  description: str = "", scores: dict | None = None) -> dict:
     """Write all files of one object; image-space outputs at the output side N = prepared.side.
 
     Args:
@@ -65,6 +65,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
             leaves them unitless and says why in material.json.
         extra: more entries for material.json (an object with several views: derender.multiview.driver).
         description: the object's catalogue description (its harvested record's title), read by the status.
+        scores: more quality scores, judged with the input view's (an object with several views: its views').
 
     Returns:
         The material.json record.
@@ -95,7 +96,7 @@ def export_object(folder: Path, item: InputItem, prepared: Prepared, state: Obje
         "pitch_source": pitch_source,
         **({"refine": refine} if refine is not None else {}),
         "environments": sorted(envs),
-        "quality": assess_drawn(prepared, drawing, description=description),
+        "quality": assess_drawn(prepared, drawing, description=description, more=scores),
         **size_record(size, real),
         **(extra or {}),
     })

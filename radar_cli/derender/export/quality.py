@@ -126,6 +126,11 @@ class QualityLimits:
     """... or more than the first (area) with less than the second of it mirrored about the axis
     (`above_rim_mirrored`): review. Volutes and handles' plates stand in pairs at the rim's ends or end-on in
     its middle; a head set on one side of the rim stands alone."""
+    review_views_outline: float = 0.015
+    """An object seen in several photos whose shared solid lies off one of their silhouettes by more than this
+    share of its height (`views_outline`; at most 0.0073 on the CVA 10 kraters' 20 side views, 0.023 with a
+    third krater's photo among two of one): review (photos of different objects in one folder, or a view that
+    is not from the side)."""
     review_cut_top: bool = True
     """An object the photo's top edge cuts: review (its rim, and whatever stands on it, is not in the photo)."""
     review_cut_sides: bool = True
@@ -288,6 +293,9 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
             record.get("base_spread") or 0) < limits.review_base_spread,
          "the object ends below in a narrow stem ({:.2f} of its width) that does not spread into a foot: broken "
          "off, or a toe made for a stand?"),
+        ("views_outline", lambda v: v > limits.review_views_outline,
+         "one of its photos lies {:.1%} of its height off the solid fitted to them all: are they all side views "
+         "of one object?"),
         ("above_rim", lambda v: v > limits.review_above_rim or (v > limits.review_above_rim_rise[0] and (
             record.get("above_rim_rise") or 0) > limits.review_above_rim_rise[1]) or (
             v > limits.review_above_rim_aside[0] and record.get("above_rim_mirrored") is not None
@@ -352,7 +360,7 @@ def assess(prepared: Prepared, state: ObjectState, limits: QualityLimits = Quali
 
 
 def assess_drawn(prepared: Prepared, drawing: InputDrawing, limits: QualityLimits = QualityLimits(),
-                 description: str = "") -> dict:
+                 description: str = "", more: dict | None = None) -> dict:
     """The `quality` record from the object drawn in the input view: its scores, status and reasons.
 
     Args:
@@ -361,8 +369,9 @@ def assess_drawn(prepared: Prepared, drawing: InputDrawing, limits: QualityLimit
         limits: the thresholds.
         description: the object's catalogue description ('' unknown): `catalogue_kind` where it names something
             other than one whole turned vessel (catalogue_terms.not_a_whole_vessel).
+        more: scores from beyond the input view, judged with its own (`views_outline`).
     """
-    record = scores(prepared, drawing)
+    record = {**scores(prepared, drawing), **(more or {})}
     kind = not_a_whole_vessel(description) if description else None
     if kind is not None:
         record.update(catalogue=description, catalogue_kind=kind)

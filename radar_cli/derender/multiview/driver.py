@@ -133,5 +133,6 @@ def derender_views(item: InputItem, predictor: Predictor, out: Path, crop: CropM
     assert first.report is not None
     export_object(folder, InputItem(item.name, Path(first.source)), first.crops, object_state(fit, predictor),
                   predictor.setup, predictor.version, envs, export, "divided", predictor.pitch, first.report.record(),
-                  size=record.size, description=record.description, extra=views_record(fit, pictures))
+                  size=record.size, description=record.description, extra=views_record(fit, pictures),
+                  scores=fit.scores())
     return failures

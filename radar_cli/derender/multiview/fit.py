@@ -97,6 +97,12 @@ class ViewFit:
         return self.crops.photo_silhouette
 
     @property
+    def outline_share(self) -> float:
+        """outline_px over the silhouette's height (NaN before the joint fit or without a silhouette)."""
+        rows = np.nonzero(self.mask.any(1))[0]
+        return self.outline_px / float(rows[-1] - rows[0] + 1) if rows.size else float("nan")
+
+    @property
     def own_fit(self) -> ShapeFit:
         assert self.own is not None, f"{self.source}: not fitted"
         return self.own
@@ -141,6 +147,13 @@ class ObjectFit:
     @property
     def used(self) -> list[ViewFit]:
         return [v for v in self.views if v.used]
+
+    def scores(self) -> dict:
+        """The object's quality scores from all its views (derender.export.quality): `views_outline`, the
+        largest share of its height by which a used view's silhouette lies off the shared solid."""
+        shares = [v.outline_share for v in self.used]
+        worst = max((s for s in shares if s == s), default=None)
+        return {"views_outline": None if worst is None else round(worst, 4)}
 
     @property
     def fused_map(self) -> Fused:
