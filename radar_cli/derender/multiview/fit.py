@@ -98,7 +98,7 @@ class ViewFit:
 
     @property
     def outline_share(self) -> float:
-        """outline_px over the silhouette's height (NaN before the joint fit or without a silhouette)."""
+        """outline_px over the silhouette's height (NaN before the joint fit)."""
         rows = np.nonzero(self.mask.any(1))[0]
         return self.outline_px / float(rows[-1] - rows[0] + 1) if rows.size else float("nan")
 
