@@ -42,7 +42,7 @@ MAX_PITCH, MAX_RATIO_ERROR, MIN_IOU = 8.0, 0.10, 0.85
 # solids of revolution
 EXPECTED_MET = {key: "not" for key in ("DP107005", "DP107356", "DP107639", "DP117537", "DP233495", "DP250469")}
 KEPT = ("outline_support", "cut_edges", "frame_coverage", "neighbour_cut", "base_off_axis", "above_rim",
-        "above_rim_rise", "above_rim_mirrored")
+        "above_rim_rise", "above_rim_mirrored", "painted_fill", "greyscale", "views_outline")
 
 
 def drawn_highlight(folder: Path) -> np.ndarray | None:

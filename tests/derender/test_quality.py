@@ -277,3 +277,33 @@ def test_a_view_into_the_mouth_is_not_ok() -> None:
     ball = (255 * np.sqrt(np.clip(1 - radius**2, 0, 1)) * 0.8 + 30).astype(np.uint8)
     photo[sil] = ball[sil][:, None]
     assert _judged(photo, sil, sil, photo) == ("ok", [])
+
+
+def test_a_mouth_drawn_dark_is_review_only_where_the_photo_shows_no_lip() -> None:
+    """A vessel seen from above with its mouth drawn black: where the photo shows the mouth (its inside lit, a
+    lip all round) the renderer's dark inner wall is no reason to doubt the result; where the photo shows the
+    outer wall's painting running on (the pitch too high), the drawn mouth is wrong."""
+    import cv2
+
+    from radar_cli.derender.export.quality import fit_scores
+
+    sil = np.zeros((160, 160), bool)
+    sil[30:150, 30:130] = True
+    mouth = np.zeros((160, 160), np.uint8)
+    cv2.ellipse(mouth, (80, 45), (46, 14), 0, 0, 360, 1, -1)
+    mouth = mouth.astype(bool) & sil
+    wall = np.full((160, 160, 3), 255, np.uint8)
+    wall[sil] = (150, 90, 60)
+    wall[sil & (np.arange(160)[:, None] % 24 < 6)] = (40, 25, 20)  # painted bands across the body
+    recon = wall.copy()
+    recon[mouth] = 10  # the inside drawn dark
+    open_mouth = wall.copy()
+    open_mouth[mouth] = (200, 170, 140)  # the photo: the inside lit, brighter than the wall
+    seen = {**GOOD, **fit_scores(open_mouth, sil, None, sil, recon, mouth)}
+    assert seen["mouth_error"] > 0.14 and seen["mouth_support"] > 0.95
+    assert not any("inside of the mouth" in r for r in judge(seen)[1])
+    unseen = {**GOOD, **fit_scores(wall, sil, None, sil, recon, mouth)}
+    assert unseen["mouth_error"] > 0.14 and unseen["mouth_support"] < 0.95
+    status, reasons = judge(unseen)
+    assert status == "review" and any("inside of the mouth" in r for r in reasons), reasons
+    assert any("inside of the mouth" in r for r in judge({**GOOD, "mouth_error": 0.2})[1])  # no support read

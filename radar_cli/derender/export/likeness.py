@@ -8,6 +8,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from radar_cli.masks.outline import CONTRAST, MIN_OUTLINE, edge_contrast
+
 BRIGHTER = 0.15
 """A recon pixel this much brighter than the photo's (luminance, 0..1) is a highlight the photo does not have."""
 GLARING = 0.3
@@ -41,6 +43,24 @@ def mouth_error(photo: np.ndarray, recon: np.ndarray, region: np.ndarray, mouth:
     if not region.any() or inside.sum() < MIN_MOUTH_SHARE * region.sum():
         return None
     return float(np.abs(luminance(recon)[inside] - luminance(photo)[inside]).mean())
+
+
+def mouth_support(photo: np.ndarray, region: np.ndarray, mouth: np.ndarray) -> float | None:
+    """Share of the drawn mouth's outline inside the region where the photo shows an edge (the colour across it,
+    read within the region, differing by over masks.outline.CONTRAST): an open mouth the photo shows has its lip
+    there, all round (0.99-1.0 on the generated vases seen into their mouths and a Met jar seen from 15 deg above,
+    whose insides the photos show lit), where a mouth drawn over the outer wall of a vessel photographed level
+    crosses its painting in part (0.16-0.83 on five CVA 10 views drawn at 15-20 deg). None where the drawn mouth
+    covers less than MIN_MOUTH_SHARE of the region.
+
+    Args:
+        photo: H x W x 3 uint8. region: H x W bool (the silhouette). mouth: H x W bool, the drawn inside.
+    """
+    inside = region & mouth
+    if not region.any() or inside.sum() < MIN_MOUTH_SHARE * region.sum():
+        return None
+    diff = edge_contrast(photo, inside, region)
+    return float((diff > CONTRAST).mean()) if len(diff) >= MIN_OUTLINE else None
 
 
 def highlight_excess(photo: np.ndarray, recon: np.ndarray, region: np.ndarray) -> float | None:

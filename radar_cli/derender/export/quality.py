@@ -15,6 +15,7 @@ from radar_cli.derender.export.likeness import (
     glaring_highlights,
     highlight_excess,
     mouth_error,
+    mouth_support,
     rim_contrast,
     shading_profile,
     shading_range,
@@ -96,7 +97,10 @@ class QualityLimits:
     """Brightness across the object changing by less than this (`shading_range`): review (a flat piece)."""
     review_mouth: float = 0.14
     """The drawn inside of the mouth off the photo by more than this (mean luminance, 0..1): review (a mouth
-    drawn where the photo shows the outer wall: the pitch too high, or no vessel)."""
+    drawn where the photo shows the outer wall: the pitch too high, or no vessel) ..."""
+    lip_support: float = 0.95
+    """... unless the photo shows an edge along at least this share of the drawn mouth's outline
+    (`mouth_support`): the mouth is there, its inside lit brighter than the renderer draws an inner wall."""
     review_highlights: float = 0.08
     """More than this share of the object drawn much brighter than the photo: review (invented highlights)."""
     review_glare: float = 0.005
@@ -215,6 +219,7 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
         "roundness": None if whole is None else _round(roundness(whole)),
         "recon_psnr": _round(psnr(recon[region], photo[region]), 2) if region.any() else None,
         "mouth_error": _round(mouth_error(photo, recon, region & rendered, mouth)),
+        "mouth_support": _round(mouth_support(photo, region & rendered, mouth)),
         "highlight_excess": _round(highlight_excess(photo, recon, region & rendered)),
         "glaring_highlights": _round(glaring_highlights(photo, recon, region & rendered, highlight)),
         "colour_shift": _round(colour_shift(photo, recon, region & rendered), 2),
@@ -307,7 +312,8 @@ def likeness_reasons(record: dict, limits: QualityLimits = QualityLimits()) -> l
          "not a side view?"),
         ("shading_range", lambda v: v < limits.review_shading,
          "no shading across the object ({:.2f}): a flat piece, not a vessel?"),
-        ("mouth_error", lambda v: v > limits.review_mouth,
+        ("mouth_error", lambda v: v > limits.review_mouth and not (record.get("mouth_support") or 0.0)
+            >= limits.lip_support,
          "the reconstruction draws the inside of the mouth where the photo shows something else ({:.2f})"),
         ("highlight_excess", lambda v: v > limits.review_highlights,
          "the reconstruction has highlights the photo does not have ({:.0%} of the object)"),
