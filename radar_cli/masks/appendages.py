@@ -21,7 +21,7 @@ import cv2
 import numpy as np
 
 from radar_cli.masks.quality import SCORE_SIDE, TILTS_DEG, mirror_agreement, sor_score
-from radar_cli.masks.refine import main_component
+from radar_cli.masks.refine import main_component, row_extents
 
 SIDE_TOLERANCE = 0.03  # a half-width may exceed the other by this fraction of the object's width (perspective)
 BUMP_SPAN = 0.1  # bumps of the radius profile shorter than this fraction of the height are appendages
@@ -318,8 +318,8 @@ def above_rim(whole: np.ndarray, core: np.ndarray, rim_rows: float = 0.02) -> tu
     standing = np.nonzero(over.any(1))[0]
     if not standing.size:
         return 0.0, 0.0, 1.0
-    ends = [np.nonzero(row)[0] for row in core[rows]]
-    axis = float(np.median([(e[0] + e[-1]) / 2.0 for e in ends if e.size])) - cols[0]  # in `over`'s columns
+    left, right = row_extents(core, rows)
+    axis = float(np.median((left + right) / 2.0)) - cols[0]  # in `over`'s columns
     ys, xs = np.nonzero(over)
     mirrored = np.rint(2.0 * axis - xs).astype(int)
     inside = (mirrored >= 0) & (mirrored < over.shape[1])

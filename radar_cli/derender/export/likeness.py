@@ -39,10 +39,14 @@ def mouth_error(photo: np.ndarray, recon: np.ndarray, region: np.ndarray, mouth:
         photo, recon: H x W x 3 uint8. region: H x W bool (the silhouette). mouth: H x W bool, the pixels where
             the solid's inside is seen (raycast `Hits.inner`).
     """
+    inside = _scored_mouth(region, mouth)
+    return None if inside is None else float(np.abs(luminance(recon)[inside] - luminance(photo)[inside]).mean())
+
+
+def _scored_mouth(region: np.ndarray, mouth: np.ndarray) -> np.ndarray | None:
+    """The drawn mouth within the region (H x W bool), or None where it covers less than MIN_MOUTH_SHARE of it."""
     inside = region & mouth
-    if not region.any() or inside.sum() < MIN_MOUTH_SHARE * region.sum():
-        return None
-    return float(np.abs(luminance(recon)[inside] - luminance(photo)[inside]).mean())
+    return inside if region.any() and inside.sum() >= MIN_MOUTH_SHARE * region.sum() else None
 
 
 def mouth_support(photo: np.ndarray, region: np.ndarray, mouth: np.ndarray) -> float | None:
@@ -56,8 +60,8 @@ def mouth_support(photo: np.ndarray, region: np.ndarray, mouth: np.ndarray) -> f
     Args:
         photo: H x W x 3 uint8. region: H x W bool (the silhouette). mouth: H x W bool, the drawn inside.
     """
-    inside = region & mouth
-    if not region.any() or inside.sum() < MIN_MOUTH_SHARE * region.sum():
+    inside = _scored_mouth(region, mouth)
+    if inside is None:
         return None
     diff = edge_contrast(photo, inside, region)
     return float((diff > CONTRAST).mean()) if len(diff) >= MIN_OUTLINE else None
