@@ -177,6 +177,26 @@ def test_a_multiview_folder_with_an_unreadable_photo_goes_on(tmp_path: Path, pre
     assert (out / "failures.csv").read_bytes() == report
 
 
+def test_a_view_into_the_mouth_is_left_out_even_beside_one_side_view(tmp_path: Path, predictor: Predictor) -> None:
+    """Two photos, a side view and one from above into the mouth (a lit rim round a dark inside): two views cannot
+    outvote each other by their profiles, but the view from above is not a side view whatever the count."""
+    import cv2
+    from PIL import Image
+
+    write_photo(tmp_path / "in" / "pot" / "front.png", 3, (96, 96))
+    top = np.full((96, 96, 3), 225, np.uint8)
+    cv2.circle(top, (48, 48), 36, (200, 170, 140), -1)  # the rim, lit
+    cv2.circle(top, (48, 48), 28, (30, 20, 15), -1)  # the dark inside
+    Image.fromarray(top).save(tmp_path / "in" / "pot" / "top.png")
+    out = tmp_path / "out"
+    summary = derender([tmp_path / "in"], predictor, DerenderOptions(out=out, export=ExportConfig(views=0,
+                                                                                                  view_size=32)))
+    assert summary.done == ["pot"]
+    views = {Path(v["source"]).name: v for v in json.loads((out / "pot" / "material.json").read_text())["views"]}
+    assert views["front.png"]["used"]
+    assert not views["top.png"]["used"] and "from above into the mouth" in views["top.png"]["reason"]
+
+
 def test_photos_of_two_vessels_in_one_folder_are_review(tmp_path: Path, predictor: Predictor) -> None:
     """Two photos of one vase and one of another in one folder: the solid drawn through all three lies off the
     odd one's silhouette (`views_outline`), and the object is not `ok`; the photos of one vase alone keep to it."""

@@ -232,6 +232,15 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
     }
 
 
+def into_the_mouth(photo: np.ndarray, region: np.ndarray, solid: np.ndarray,
+                   limits: QualityLimits = QualityLimits()) -> bool:
+    """Whether a photo looks from above into the mouth, as the `roundness` reason reads it: the silhouette round
+    and a lit rim round a dark inside (photo N x N x 3 uint8, region its N x N bool silhouette, solid the fitted
+    solid's)."""
+    return (roundness(region) >= limits.review_roundness
+            and (rim_contrast(shading_profile(photo, region, solid)) or 0.0) >= limits.review_rim)
+
+
 def judge(record: dict, limits: QualityLimits = QualityLimits()) -> tuple[str, list[str]]:
     """(status, reasons) of a quality record's scores: `failed` if any failing reason, else `review` if any
     reason, else `ok`."""

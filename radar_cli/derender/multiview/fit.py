@@ -12,6 +12,7 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig
+from radar_cli.derender.export.quality import into_the_mouth
 from radar_cli.derender.multiview.fuse import FuseConfig, Fused, ViewTexture, fuse, match_exposure, unwrap_view
 from radar_cli.derender.multiview.joint_shape import Geometry, fit_jointly, profile_spread
 from radar_cli.derender.multiview.turns import TurnConfig, Turns, handle_phase, register_turns
@@ -24,6 +25,7 @@ from radar_cli.derender.run.predictor import Predictor
 from radar_cli.derender.run.state import ObjectState, quantise
 from radar_cli.derender.run.upsample import PROFILE_ROWS, photo_tensors
 from radar_cli.model.outputs import Decomposition
+from radar_cli.sor.outline import row_mask
 from radar_cli.sor.resample import smooth_rows
 from radar_cli.sor.solid import Solid
 from radar_cli.threads import thread_map, torch_threads
@@ -183,7 +185,12 @@ def own_fits(views: list[ViewFit], decs: list[Decomposition], config: MultiviewC
 
 
 def choose_side_views(views: list[ViewFit], config: MultiviewConfig) -> None:
-    """Leave out the views whose own profile or outline disagrees with the others' (not seen from the side)."""
+    """Leave out the views that look from above into the mouth (quality.into_the_mouth, however many views there
+    are), then those whose own profile or outline disagrees with the others' (not seen from the side)."""
+    for view in (v for v in views if v.used):
+        if into_the_mouth(view.photo, view.mask, row_mask(view.own_fit.drawn)[0].numpy()):
+            view.used, view.reason = False, ("not a side view: it looks from above into the mouth (round, a lit "
+                                             "rim round a dark inside)")
     candidates = [v for v in views if v.used]
     if len(candidates) < 3:
         return  # two views cannot outvote each other
