@@ -197,6 +197,23 @@ def test_a_view_into_the_mouth_is_left_out_even_beside_one_side_view(tmp_path: P
     assert not views["top.png"]["used"] and "from above into the mouth" in views["top.png"]["reason"]
 
 
+def test_a_detail_beside_a_whole_view_is_left_out(tmp_path: Path, predictor: Predictor) -> None:
+    """A close-up whose painted figure is what the locator finds (not symmetric about any axis) beside a whole
+    side view: left out, and the object is fitted to the whole view."""
+    from PIL import Image
+
+    write_photo(tmp_path / "in" / "pot" / "front.png", 3, (96, 96))
+    detail = np.full((96, 96, 3), 225, np.uint8)
+    detail[20:80, 25:40] = (150, 90, 60)  # a figure's leg and body, leaning to one side
+    detail[20:35, 25:75] = (150, 90, 60)
+    Image.fromarray(detail).save(tmp_path / "in" / "pot" / "detail.png")
+    out = tmp_path / "out"
+    derender([tmp_path / "in"], predictor, DerenderOptions(out=out, export=ExportConfig(views=0, view_size=32)))
+    views = {Path(v["source"]).name: v for v in json.loads((out / "pot" / "material.json").read_text())["views"]}
+    assert views["front.png"]["used"]
+    assert not views["detail.png"]["used"] and "not a whole view" in views["detail.png"]["reason"]
+
+
 def test_photos_of_two_vessels_in_one_folder_are_review(tmp_path: Path, predictor: Predictor) -> None:
     """Two photos of one vase and one of another in one folder: the solid drawn through all three lies off the
     odd one's silhouette (`views_outline`), and the object is not `ok`; the photos of one vase alone keep to it."""

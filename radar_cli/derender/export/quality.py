@@ -232,6 +232,18 @@ def fit_scores(photo: np.ndarray, sil: np.ndarray | None, app: np.ndarray | None
     }
 
 
+def frame_cut(edges: list[str] | tuple[str, ...], limits: QualityLimits = QualityLimits()) -> str | None:
+    """Why the photo's frame keeps the object from being seen whole, from the edges that cut it (three or more,
+    the top, or both sides), or None."""
+    if len(edges) >= limits.review_cut_edges:
+        return f"cut by {len(edges)} photo edges"
+    if limits.review_cut_top and "top" in edges:
+        return "the photo's frame cuts off the object's top: its rim, and whatever stands on it, is not seen"
+    if limits.review_cut_sides and {"left", "right"} <= set(edges):
+        return "the photo's frame cuts off both sides of the object: its full width is not seen"
+    return None
+
+
 def into_the_mouth(photo: np.ndarray, region: np.ndarray, solid: np.ndarray,
                    limits: QualityLimits = QualityLimits()) -> bool:
     """Whether a photo looks from above into the mouth, as the `roundness` reason reads it: the silhouette round
@@ -268,12 +280,8 @@ def judge(record: dict, limits: QualityLimits = QualityLimits()) -> tuple[str, l
     if outline is not None and outline < limits.review_support:
         review.append(f"silhouette off the object's edge ({outline:.0%} of its outline on an edge)")
     review += likeness_reasons(record, limits)
-    if len(record.get("cut_edges", [])) >= limits.review_cut_edges:
-        review.append(f"cut by {len(record['cut_edges'])} photo edges")
-    elif limits.review_cut_top and "top" in record.get("cut_edges", []):
-        review.append("the photo's frame cuts off the object's top: its rim, and whatever stands on it, is not seen")
-    elif limits.review_cut_sides and {"left", "right"} <= set(record.get("cut_edges", [])):
-        review.append("the photo's frame cuts off both sides of the object: its full width is not seen")
+    cut = frame_cut(record.get("cut_edges", []), limits)
+    review += [cut] if cut else []
     review += locating_reasons(record, limits)
     if record.get("catalogue_kind"):
         review.append(f"the catalogue calls it '{record.get('catalogue')}': {record['catalogue_kind']}, not one "

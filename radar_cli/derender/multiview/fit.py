@@ -12,7 +12,7 @@ import numpy as np
 import torch
 
 from radar_cli.config import CameraConfig
-from radar_cli.derender.export.quality import into_the_mouth
+from radar_cli.derender.export.quality import QualityLimits, frame_cut, into_the_mouth
 from radar_cli.derender.multiview.fuse import FuseConfig, Fused, ViewTexture, fuse, match_exposure, unwrap_view
 from radar_cli.derender.multiview.joint_shape import Geometry, fit_jointly, profile_spread
 from radar_cli.derender.multiview.turns import TurnConfig, Turns, handle_phase, register_turns
@@ -24,6 +24,7 @@ from radar_cli.derender.run.inputs import Prepared
 from radar_cli.derender.run.predictor import Predictor
 from radar_cli.derender.run.state import ObjectState, quantise
 from radar_cli.derender.run.upsample import PROFILE_ROWS, photo_tensors
+from radar_cli.masks.quality import sor_score
 from radar_cli.model.outputs import Decomposition
 from radar_cli.sor.outline import row_mask
 from radar_cli.sor.resample import smooth_rows
@@ -184,13 +185,33 @@ def own_fits(views: list[ViewFit], decs: list[Decomposition], config: MultiviewC
     thread_map(fit, list(zip([v for v in views if v.prepared is not None], decs)), workers)
 
 
+def _not_whole(view: ViewFit) -> str | None:
+    """Why a view does not show the object whole, as the status reads a single photo: its frame cuts it
+    (quality.frame_cut), or what it located is not symmetric about an axis (a detail whose painting was taken for
+    the object, or another object); None where it does."""
+    limits = QualityLimits()
+    cut = frame_cut(view.crops.cut_edges, limits)
+    if cut:
+        return cut
+    whole = view.mask if view.crops.appendages is None else view.mask | view.crops.appendages
+    symmetry = sor_score(whole)
+    if symmetry < limits.review_object_symmetry:
+        return f"what it shows is not symmetric about an axis ({symmetry:.2f}): a detail, or another object?"
+    return None
+
+
 def choose_side_views(views: list[ViewFit], config: MultiviewConfig) -> None:
-    """Leave out the views that look from above into the mouth (quality.into_the_mouth, however many views there
-    are), then those whose own profile or outline disagrees with the others' (not seen from the side)."""
+    """Leave out the views that look from above into the mouth (quality.into_the_mouth) and, where another view
+    shows the object whole, those that do not (`_not_whole`: a detail, another object), however many views there
+    are; then those whose own profile or outline disagrees with the others' (not seen from the side)."""
     for view in (v for v in views if v.used):
         if into_the_mouth(view.photo, view.mask, row_mask(view.own_fit.drawn)[0].numpy()):
             view.used, view.reason = False, ("not a side view: it looks from above into the mouth (round, a lit "
                                              "rim round a dark inside)")
+    partial = {id(v): _not_whole(v) for v in views if v.used}
+    if any(reason is None for reason in partial.values()):
+        for view in (v for v in views if v.used and partial[id(v)]):
+            view.used, view.reason = False, f"not a whole view: {partial[id(view)]}"
     candidates = [v for v in views if v.used]
     if len(candidates) < 3:
         return  # two views cannot outvote each other
